@@ -1,0 +1,4 @@
+if(TARGET assimp::assimp)
+  return()
+endif()
+find_package(assimp REQUIRED)

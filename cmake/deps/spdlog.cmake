@@ -1,0 +1,5 @@
+if(TARGET spdlog::spdlog)
+  return()
+endif()
+find_package(fmt REQUIRED)
+find_package(spdlog REQUIRED)

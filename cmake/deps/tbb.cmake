@@ -1,0 +1,4 @@
+if(TARGET TBB::tbb)
+  return()
+endif()
+find_package(TBB REQUIRED)

@@ -1,0 +1,4 @@
+if(TARGET yaml-cpp)
+  return()
+endif()
+find_package(yaml-cpp REQUIRED)

@@ -1,0 +1,81 @@
+// Model: everything read-only during a run (STYLE H.4): grid, time control, gravity, materials,
+// domain walls, output plan. Built once from a scene by scene_builder.cpp.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "materials/material_params.h"
+
+namespace surge {
+
+enum class ShapeFunction { kLinear, kGimp, kQuadraticBspline, kCubicBspline };
+enum class TransferScheme { kFlip, kPicFlip, kApic };
+enum class UpdateScheme { kUsl, kMusl };
+
+// Domain faces, in the order of Model::walls.
+enum class Face { kXMin = 0, kXMax, kYMin, kYMax, kZMin, kZMax };
+inline constexpr int kFaceCount = 6;
+const char* FaceName(Face f);  // "x-", "x+", ...
+
+enum class WallKind {
+  kOpen,     // no wall: particles leaving are removed or stop the run (Model::exit_policy)
+  kSlip,     // v.n >= 0 (separable) or v.n = 0 (bilateral); tangential free (seed Planar)
+  kNoSlip,   // v = 0 at wall nodes (seed Fixed)
+  kFriction  // Coulomb friction with coefficient `friction` (seed Planar with mu > 0)
+};
+
+struct Wall {
+  WallKind kind = WallKind::kOpen;
+  Real friction = 0;     // Coulomb coefficient [-] (kFriction only)
+  bool separable = true; // true: the wall only pushes (tension release); false: bilateral
+};
+
+enum class ExitPolicy { kRemove, kStop };
+
+struct TimeControl {
+  Real end = 0;        // simulated end time [s]
+  Real cfl = 0.4;      // Courant number C in dt = C dx / max(c + |v|) (spec §1.7)
+  Real min_dt = 0;     // below this the run stops with a diagnostic [s]
+  Real max_dt = 1e30;  // upper bound [s]
+  Real fixed_dt = 0;   // > 0: use this dt every step (seed reproduction runs) [s]
+};
+
+struct BodyInfo {
+  std::string name;
+  int material = 0;
+};
+
+struct OutputPlan {
+  Real every = 0;          // particle snapshot interval [s]; 0 = first and last only
+  bool vdb = false;        // also write grid fields (mass, velocity) as .vdb per snapshot
+  bool energy = true;      // energy series every step
+};
+
+struct Model {
+  std::string name;
+  int dim = 3;                     // 2 = plane strain in the z = 0 slab, 3 = full 3-D
+  Real dx = 0;                     // grid cell size [m]
+  ShapeFunction shape = ShapeFunction::kQuadraticBspline;
+  TransferScheme transfer = TransferScheme::kApic;
+  Real flip_ratio = 1.0;           // alpha in v = alpha*FLIP + (1-alpha)*PIC (kPicFlip)
+  UpdateScheme scheme = UpdateScheme::kUsl;
+  Vec3 gravity = Vec3::Zero();     // [m/s^2]
+  Real gravity_ramp = 0;           // external loads scaled by min(t/ramp, 1) (seed App. B.2.3) [s]
+  TimeControl time;
+  Vec3 domain_min = Vec3::Zero();  // [m]
+  Vec3 domain_max = Vec3::Zero();  // [m]
+  std::array<Wall, kFaceCount> walls;
+  ExitPolicy exit_policy = ExitPolicy::kRemove;
+  std::vector<Material> materials;
+  std::vector<BodyInfo> bodies;
+  OutputPlan output;
+};
+
+// Load factor of the external-force ramp at time t (seed App. B.2.3 ExternalForceRamp).
+inline Real RampFactor(const Model& m, Real t) {
+  return m.gravity_ramp > 0 && t < m.gravity_ramp ? t / m.gravity_ramp : 1.0;
+}
+
+}  // namespace surge

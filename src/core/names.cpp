@@ -1,0 +1,19 @@
+// Display names of the core enums.
+#include "core/model.h"
+#include "core/stage.h"
+
+namespace surge {
+
+const char* StageName(Stage s) {
+  static constexpr const char* kNames[kStageCount] = {
+      "rebuild_grid", "particle_to_grid", "grid_update", "grid_to_particle", "remap_momentum",
+      "velocity_gradient", "update_stress", "domain_exit", "check_state", "energy"};
+  return kNames[static_cast<int>(s)];
+}
+
+const char* FaceName(Face f) {
+  static constexpr const char* kNames[kFaceCount] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+  return kNames[static_cast<int>(f)];
+}
+
+}  // namespace surge

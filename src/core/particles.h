@@ -1,0 +1,62 @@
+// Particle storage: structure of arrays (STYLE H.4). Index p is the same particle in every array.
+// SI units, tension positive (Mast 2013 convention).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/math.h"
+
+namespace surge {
+
+struct Particles {
+  // --- State: advanced by Step(), saved in checkpoints. ---
+  std::vector<Vec3> x;       // position [m]                      written by GridToParticle
+  std::vector<Vec3> v;       // velocity [m/s]                    written by GridToParticle
+  std::vector<Mat3> C;       // APIC affine velocity [1/s]        written by GridToParticle (APIC)
+  std::vector<Mat3> F;       // deformation gradient [-]          written by UpdateDeformation
+  std::vector<Mat3> stress;  // Cauchy stress [Pa]                written by UpdateStress
+  std::vector<Mat3> strain;  // accumulated small strain [-]      written by UpdateStress
+  // --- Constant: set by the scene builder, never written by Step(). ---
+  std::vector<Real> mass;         // [kg]
+  std::vector<Real> volume0;      // reference volume [m^3]
+  std::vector<Vec3> ext_force;    // particle traction force t*A_p [N] (Mast 2013 App. B.2.9)
+  std::vector<int32_t> material;  // index into Model::materials
+  std::vector<int32_t> body;      // index into Model::bodies
+  std::vector<int64_t> id;        // seeding order, stable across removals
+
+  size_t size() const { return x.size(); }
+
+  void Resize(size_t n) {
+    x.resize(n);
+    v.resize(n);
+    C.resize(n);
+    F.resize(n);
+    stress.resize(n);
+    strain.resize(n);
+    mass.resize(n);
+    volume0.resize(n);
+    ext_force.resize(n);
+    material.resize(n);
+    body.resize(n);
+    id.resize(n);
+  }
+
+  // Copies particle `from` into slot `to` (used by stable compaction and sorting).
+  void Move(size_t to, size_t from) {
+    x[to] = x[from];
+    v[to] = v[from];
+    C[to] = C[from];
+    F[to] = F[from];
+    stress[to] = stress[from];
+    strain[to] = strain[from];
+    mass[to] = mass[from];
+    volume0[to] = volume0[from];
+    ext_force[to] = ext_force[from];
+    material[to] = material[from];
+    body[to] = body[from];
+    id[to] = id[from];
+  }
+};
+
+}  // namespace surge

@@ -1,0 +1,43 @@
+// Pipeline stages: names used in logs, HDF5 attributes and benchmark CSVs (STYLE H.3).
+#pragma once
+#include <array>
+#include <chrono>
+
+namespace surge {
+
+enum class Stage : int {
+  kRebuildGrid = 0,
+  kParticleToGrid,
+  kGridUpdate,
+  kGridToParticle,
+  kRemapMomentum,      // MUSL only
+  kVelocityGradient,   // MUSL only
+  kUpdateStress,
+  kDomainExit,
+  kCheckState,
+  kEnergy,
+  kCount
+};
+inline constexpr int kStageCount = static_cast<int>(Stage::kCount);
+
+const char* StageName(Stage s);
+
+using StageSeconds = std::array<double, kStageCount>;
+
+// Accumulates wall time per stage: Lap(s) charges the time since the last lap to stage s.
+class StageClock {
+ public:
+  explicit StageClock(StageSeconds& sink) : sink_(sink), last_(Clock::now()) {}
+  void Lap(Stage s) {
+    const auto now = Clock::now();
+    sink_[static_cast<int>(s)] += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  StageSeconds& sink_;
+  Clock::time_point last_;
+};
+
+}  // namespace surge

@@ -1,0 +1,28 @@
+// State: exactly what a checkpoint holds (STYLE H.4): a restart from it is bitwise identical.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/particles.h"
+
+namespace surge {
+
+// A contiguous particle range [begin, end) of one material (particles are grouped by material,
+// so UpdateStress does one std::visit per group and then a monomorphic loop).
+struct MaterialGroup {
+  int material = 0;
+  size_t begin = 0;
+  size_t end = 0;
+};
+
+struct State {
+  Real time = 0;       // simulated time [s]
+  int64_t step = 0;    // completed steps
+  Real dt = 0;         // time step used by the last completed step [s]
+  Particles particles;
+  std::vector<MaterialGroup> groups;
+  int64_t particles_removed = 0;  // particles that left through open domain sides
+  Real wall_work = 0;             // cumulative work done on the particles by walls [J]
+};
+
+}  // namespace surge

@@ -1,0 +1,29 @@
+// What one step reports besides the State: energies and health (STYLE H.7).
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "core/math.h"
+
+namespace surge {
+
+// Energy balance terms [J] at the end of a step. 2-D values are per metre of thickness.
+struct EnergyRecord {
+  Real time = 0;
+  int64_t step = 0;
+  Real dt = 0;
+  Real kinetic = 0;        // sum 1/2 m |v|^2
+  Real strain = 0;         // sum psi(F) V0 (hyperelastic) or 1/2 sigma:eps V (linear elastic)
+  Real gravitational = 0;  // sum -m g . x  (zero level at the origin)
+  Real wall_work = 0;      // cumulative work of the domain walls on the particles
+};
+
+enum class HealthStatus { kOk, kNonFinite, kInvertedElement, kLeftDomain, kTimeStepTooSmall };
+
+struct Health {
+  HealthStatus status = HealthStatus::kOk;
+  int64_t particle_id = -1;  // first offender (seeding id)
+  std::string detail;        // field and value, for the diagnostic
+};
+
+}  // namespace surge
