@@ -1,0 +1,31 @@
+// Public scene API: scene file (YAML, docs/scene-reference.md) -> Model + State.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/model.h"
+#include "core/state.h"
+#include "scene/scene_error.h"
+
+namespace surge {
+
+struct LoadedScene {
+  std::string path;           // file path, or "<string>" for LoadSceneFromString
+  std::string text;           // the scene file verbatim
+  std::string resolved_yaml;  // the parsed spec with every default filled in, as YAML
+  Model model;
+  State state;  // particles seeded, grouped by material (stable sort), groups filled
+};
+
+// Reads, validates and builds the scene in `path`. `overrides` are "key.path=value" strings (as
+// given to --set), applied to the YAML tree before validation; list indices are numbers
+// ("bodies.0.velocity=[2,0,0]"). Relative mesh paths are taken from the scene file's directory.
+// Throws SceneError (file:line:column: key.path: message) on any problem with the input.
+LoadedScene LoadScene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// As LoadScene, from text; `name_for_errors` stands for the file name in errors, and relative
+// mesh paths are taken from the current directory.
+LoadedScene LoadSceneFromString(const std::string& text, const std::string& name_for_errors,
+                                const std::vector<std::string>& overrides = {});
+
+}  // namespace surge

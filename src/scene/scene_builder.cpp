@@ -1,0 +1,239 @@
+// Scene builder: SceneSpec -> Model + State. Holds the one table of material kinds
+// (STYLE H.5), seeds every body (particle_sampling.cpp), sets initial stress and tractions, and
+// groups the particles by material.
+#include "scene/scene_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "mesh/mesh.h"
+#include "scene/particle_sampling.h"
+#include "scene/scene_error.h"
+
+namespace surge {
+namespace {
+
+MaterialParams MakeLinearElastic(const MaterialSpec& m) {
+  return LinearElasticParams{m.bulk_modulus, m.shear_modulus};
+}
+MaterialParams MakeNeoHookean(const MaterialSpec& m) {
+  return NeoHookeanParams{m.bulk_modulus, m.shear_modulus};
+}
+
+// The one table of material kinds. A new model adds a MaterialModel value, a params struct in
+// materials/material_params.h and a row here. Geostatic initial stress is refused for
+// hyperelastic models: their stress is a function of F, which starts at I.
+constexpr MaterialKind kMaterialKinds[] = {
+    {"linear_elastic", MaterialModel::kLinearElastic, true, &MakeLinearElastic},
+    {"neo_hookean", MaterialModel::kNeoHookean, false, &MakeNeoHookean},
+};
+
+// Total particles allowed in one scene, and lattice candidates scanned for one body.
+constexpr double kMaxParticles = 2e8;
+constexpr double kMaxCandidates = 4e8;
+
+std::string BodyPath(size_t b) { return "bodies[" + std::to_string(b) + "]"; }
+
+[[noreturn]] void Fail(const SourceLoc& loc, const std::string& path, const std::string& msg) {
+  throw SceneError(loc.source, loc.line, loc.column, path, msg);
+}
+
+std::string Point(const Vec3& x, int dim) {
+  std::string s = "(";
+  for (int a = 0; a < dim; ++a) s += (a ? ", " : "") + std::to_string(x[a]);
+  return s + ")";
+}
+
+// Particles of one body, in seeding order.
+struct SeededBody {
+  std::vector<Vec3> x;
+  std::vector<Mat3> stress;
+  std::vector<Vec3> ext_force;
+  Real volume0 = 0;  // [m^3] (2-D: per 1 m thickness)
+  Real mass = 0;     // [kg]
+};
+
+SeededBody SeedBody(const SceneSpec& spec, size_t b) {
+  const BodySpec& body = spec.bodies[b];
+  const MaterialSpec& material = spec.materials[body.material_index];
+  const int dim = spec.dimension;
+  const std::string path = BodyPath(b);
+  const Real s = spec.grid.cell_size / body.particles_per_cell;  // particle spacing [m]
+
+  TriangleMesh mesh;
+  const TriangleMesh* mesh_ptr = nullptr;
+  if (const auto* region = std::get_if<MeshRegion>(&body.region)) {
+    const std::string file_path = path + ".region.mesh.file";
+    try {
+      mesh = ReadTriangleMesh(region->file);
+    } catch (const std::exception& e) {
+      Fail(region->file_loc, file_path, e.what());
+    }
+    for (Vec3& v : mesh.vertices) v = region->scale * v + region->translate;
+    const int open = CountOpenEdges(mesh);
+    if (open > 0) {
+      Fail(region->file_loc, file_path,
+           "mesh '" + region->file + "' is not closed: " + std::to_string(open) +
+               " edges are not shared by exactly two triangles (the inside test needs a "
+               "watertight mesh)");
+    }
+    mesh_ptr = &mesh;
+  }
+
+  const double candidates = CountLatticePoints(RegionBounds(body.region, mesh_ptr), dim, s);
+  if (candidates > kMaxCandidates) {
+    Fail(body.region_loc, path + ".region",
+         "the region spans about " + std::to_string(static_cast<long long>(candidates)) +
+             " particle lattice points at spacing " + std::to_string(s) +
+             " m (limit 4e8); use a larger cell_size or fewer particles_per_cell");
+  }
+
+  SeededBody out;
+  out.x = SampleRegion(body.region, dim, s, mesh_ptr);
+  if (out.x.empty()) {
+    Fail(body.region_loc, path + ".region",
+         "the region contains no particles at spacing " + std::to_string(s) +
+             " m (cell_size / particles_per_cell); it may be thinner than one spacing");
+  }
+  JitterPositions(dim, s, body.jitter, body.seed, out.x);
+
+  for (const Vec3& x : out.x) {
+    for (int a = 0; a < dim; ++a) {
+      if (!(spec.domain.min[a] <= x[a] && x[a] <= spec.domain.max[a])) {
+        Fail(body.region_loc, path + ".region",
+             "body '" + body.name + "' has a particle at " + Point(x, dim) +
+                 " outside the domain " + Point(spec.domain.min, dim) + " - " +
+                 Point(spec.domain.max, dim));
+      }
+    }
+  }
+
+  out.volume0 = dim == 3 ? s * s * s : s * s * 1.0;  // 2-D plane strain: 1 m thickness
+  out.mass = material.density * out.volume0;
+  const size_t n = out.x.size();
+  out.stress.assign(n, Mat3::Zero());
+  out.ext_force.assign(n, Vec3::Zero());
+
+  if (body.geostatic_k0) {
+    // K0 geostatic state (Mast 2013 §7.4, eq. (7.17) uses the same K0 earth pressure;
+    // spec/seed-algorithms.md "Initial stress" [REC]): sigma_v = -rho |g| d (compression
+    // negative), sigma_h = K0 sigma_v, d = depth below the body's top surface along g.
+    const Real g = spec.gravity.norm();
+    const Vec3 ghat = spec.gravity / g;
+    const Mat3 vertical = ghat * ghat.transpose();
+    const Mat3 horizontal = Mat3::Identity() - vertical;
+    Real h_top = -std::numeric_limits<Real>::infinity();
+    for (const Vec3& x : out.x) h_top = std::max(h_top, -ghat.dot(x));
+    h_top += 0.5 * s;  // the free surface lies half a spacing above the top particle layer
+    for (size_t p = 0; p < n; ++p) {
+      const Real depth = h_top + ghat.dot(out.x[p]);
+      const Real sigma_v = -material.density * g * depth;
+      out.stress[p] = sigma_v * vertical + (*body.geostatic_k0) * sigma_v * horizontal;
+    }
+  }
+
+  // Tractions on the outermost particle layer of a face: f_p = t A_p with A_p = V_p / s
+  // (Mast 2013 App. B.2.9, particle traction).
+  const Real area = out.volume0 / s;
+  for (const TractionSpec& t : body.tractions) {
+    const int axis = static_cast<int>(t.face) / 2;
+    const bool at_max = static_cast<int>(t.face) % 2 == 1;
+    Real extreme = out.x[0][axis];
+    for (const Vec3& x : out.x) extreme = at_max ? std::max(extreme, x[axis]) : std::min(extreme, x[axis]);
+    for (size_t p = 0; p < n; ++p) {
+      if (std::abs(out.x[p][axis] - extreme) <= 0.5 * s) out.ext_force[p] += t.traction * area;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::span<const MaterialKind> MaterialKinds() { return kMaterialKinds; }
+
+const MaterialKind& FindMaterialKind(MaterialModel model) {
+  for (const MaterialKind& k : kMaterialKinds) {
+    if (k.model == model) return k;
+  }
+  return kMaterialKinds[0];  // unreachable: every MaterialModel has a row
+}
+
+void BuildScene(const SceneSpec& spec, Model& model, State& state) {
+  model = Model{};
+  model.name = spec.name;
+  model.dim = spec.dimension;
+  model.dx = spec.grid.cell_size;
+  model.shape = spec.grid.shape_function;
+  model.transfer = spec.grid.transfer;
+  // alpha of v = alpha FLIP + (1 - alpha) PIC: pure FLIP, the given blend, or none for APIC.
+  model.flip_ratio = spec.grid.transfer == TransferScheme::kFlip      ? 1.0
+                     : spec.grid.transfer == TransferScheme::kPicFlip ? spec.grid.flip_ratio
+                                                                      : 0.0;
+  model.scheme = spec.grid.update;
+  model.gravity = spec.gravity;
+  model.gravity_ramp = spec.gravity_ramp;
+  model.time.end = spec.time.end;
+  model.time.cfl = spec.time.cfl;
+  model.time.min_dt = spec.time.min_dt;
+  model.time.max_dt = spec.time.max_dt;
+  model.time.fixed_dt = spec.time.fixed_dt;
+  model.domain_min = spec.domain.min;
+  model.domain_max = spec.domain.max;
+  model.walls = spec.domain.walls;
+  model.exit_policy = spec.domain.on_exit;
+  for (const MaterialSpec& m : spec.materials) {
+    model.materials.push_back(
+        Material{m.name, m.density, FindMaterialKind(m.model).make_params(m)});
+  }
+  for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
+  model.output.every = spec.output.every;
+  model.output.vdb = spec.output.vdb;
+  model.output.energy = spec.output.energy;
+
+  // Seed every body; ids follow seeding order (body by body).
+  std::vector<SeededBody> seeded;
+  std::vector<int64_t> first_id;
+  double total = 0;
+  for (size_t b = 0; b < spec.bodies.size(); ++b) {
+    first_id.push_back(static_cast<int64_t>(total));
+    seeded.push_back(SeedBody(spec, b));
+    total += static_cast<double>(seeded.back().x.size());
+    if (total > kMaxParticles) {
+      Fail(spec.bodies[b].loc, BodyPath(b),
+           "the scene has more than 2e8 particles (" + std::to_string(static_cast<long long>(total)) +
+               " after body '" + spec.bodies[b].name + "')");
+    }
+  }
+
+  // Lay the particles out grouped by material, bodies in file order within a group: the same
+  // order as a stable sort of the seeding order by material index.
+  state = State{};
+  Particles& P = state.particles;
+  P.Resize(static_cast<size_t>(total));
+  size_t next = 0;
+  for (size_t m = 0; m < spec.materials.size(); ++m) {
+    const size_t begin = next;
+    for (size_t b = 0; b < spec.bodies.size(); ++b) {
+      if (spec.bodies[b].material_index != static_cast<int>(m)) continue;
+      const SeededBody& s = seeded[b];
+      for (size_t k = 0; k < s.x.size(); ++k, ++next) {
+        P.x[next] = s.x[k];
+        P.v[next] = spec.bodies[b].velocity;
+        P.C[next] = Mat3::Zero();
+        P.F[next] = Mat3::Identity();
+        P.stress[next] = s.stress[k];
+        P.strain[next] = Mat3::Zero();
+        P.mass[next] = s.mass;
+        P.volume0[next] = s.volume0;
+        P.ext_force[next] = s.ext_force[k];
+        P.material[next] = static_cast<int32_t>(m);
+        P.body[next] = static_cast<int32_t>(b);
+        P.id[next] = first_id[b] + static_cast<int64_t>(k);
+      }
+    }
+    if (next > begin) state.groups.push_back(MaterialGroup{static_cast<int>(m), begin, next});
+  }
+}
+
+}  // namespace surge

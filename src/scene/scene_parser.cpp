@@ -1,0 +1,899 @@
+// Scene parser: YAML text -> validated SceneSpec (strict: unknown keys, wrong types and
+// out-of-range values are SceneErrors naming file, line, key path, range and unit), and the
+// writer SceneSpecToYaml that emits the same fields in the same order with defaults filled in.
+// The file format is documented in docs/scene-reference.md; keep the two in step.
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "scene/scene_error.h"
+#include "scene/scene_spec.h"
+
+namespace surge {
+namespace {
+
+constexpr Real kInf = std::numeric_limits<Real>::infinity();
+
+// Shortest decimal text that reads back to the same double.
+std::string Num(Real v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, r.ptr);
+}
+
+template <class E>
+struct EnumName {
+  const char* name;
+  E value;
+};
+
+constexpr EnumName<ShapeFunction> kShapeNames[] = {
+    {"linear", ShapeFunction::kLinear},
+    {"gimp", ShapeFunction::kGimp},
+    {"quadratic_bspline", ShapeFunction::kQuadraticBspline},
+    {"cubic_bspline", ShapeFunction::kCubicBspline}};
+constexpr EnumName<TransferScheme> kTransferNames[] = {{"flip", TransferScheme::kFlip},
+                                                       {"pic_flip", TransferScheme::kPicFlip},
+                                                       {"apic", TransferScheme::kApic}};
+constexpr EnumName<UpdateScheme> kUpdateNames[] = {{"usl", UpdateScheme::kUsl},
+                                                   {"musl", UpdateScheme::kMusl}};
+constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
+                                               {"stop", ExitPolicy::kStop}};
+constexpr EnumName<WallKind> kWallNames[] = {{"open", WallKind::kOpen},
+                                             {"slip", WallKind::kSlip},
+                                             {"no_slip", WallKind::kNoSlip},
+                                             {"friction", WallKind::kFriction}};
+
+template <class E, size_t N>
+const char* NameOf(const EnumName<E> (&table)[N], E value) {
+  for (const auto& e : table) {
+    if (e.value == value) return e.name;
+  }
+  return "?";
+}
+
+std::string Join(const std::vector<std::string>& items) {
+  std::string s;
+  for (size_t i = 0; i < items.size(); ++i) s += (i ? ", " : "") + items[i];
+  return s;
+}
+
+std::string Child(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+std::string Index(const std::string& path, size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+// True if `path` is `prefix` or lies below it ("a.b" is under "a", "a[0]" is under "a").
+bool IsUnder(const std::string& path, const std::string& prefix) {
+  if (path.compare(0, prefix.size(), prefix) != 0) return false;
+  return path.size() == prefix.size() || path[prefix.size()] == '.' || path[prefix.size()] == '[';
+}
+
+std::string Describe(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "nothing";
+  if (n.IsScalar()) return "\"" + n.Scalar() + "\"";
+  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
+  return "a map";
+}
+
+// A --set override after it has been applied: its text and the display path it set.
+struct AppliedOverride {
+  std::string text;  // "--set bodies.0.velocity=[2,0,0]"
+  std::string path;  // "bodies[0].velocity"
+};
+
+// Applies "key.path=value" to the node tree (before validation). Map keys may be created;
+// list indices must exist.
+AppliedOverride ApplyOverride(YAML::Node root, const std::string& text) {
+  const std::string where = "--set " + text;
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw SceneError(where, 0, 0, "", "expected key.path=value, e.g. time.end=0.5");
+  }
+  const std::string key = text.substr(0, eq);
+  std::vector<std::string> parts;
+  for (size_t start = 0;;) {
+    const size_t dot = key.find('.', start);
+    parts.push_back(key.substr(start, dot == std::string::npos ? dot : dot - start));
+    if (parts.back().empty()) throw SceneError(where, 0, 0, key, "empty component in key path");
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  YAML::Node value;
+  try {
+    value = YAML::Load(text.substr(eq + 1));
+  } catch (const YAML::Exception& e) {
+    throw SceneError(where, 0, 0, key, "cannot parse the value as YAML: " + e.msg);
+  }
+
+  YAML::Node cur(root);
+  std::string path;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    const bool last = i + 1 == parts.size();
+    if (cur.IsSequence()) {
+      const bool digits = std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (!digits || part.size() > 9) {
+        throw SceneError(where, 0, 0, path, "expected a list index, got '" + part + "'");
+      }
+      const size_t index = std::stoul(part);
+      path = Index(path, index);
+      if (index >= cur.size()) {
+        throw SceneError(where, 0, 0, path,
+                         "list index " + part + " out of range (the list has " +
+                             std::to_string(cur.size()) + " items)");
+      }
+      if (last) {
+        cur[index] = value;
+      } else {
+        YAML::Node next = cur[index];
+        cur.reset(next);
+      }
+    } else if (cur.IsMap() || cur.IsNull()) {
+      path = Child(path, part);
+      if (last) {
+        cur[part] = value;
+      } else {
+        const YAML::Node existing = cur[part];
+        if (!existing.IsDefined() || existing.IsNull()) cur[part] = YAML::Node(YAML::NodeType::Map);
+        YAML::Node next = cur[part];
+        cur.reset(next);
+      }
+    } else {
+      throw SceneError(where, 0, 0, path, "cannot set key '" + part + "' inside a single value");
+    }
+  }
+  return {where, path};
+}
+
+// Validating reader over a YAML node tree. Every accessor takes the node and its display path.
+class Parser {
+ public:
+  Parser(std::string source, std::string base_dir, std::vector<AppliedOverride> overrides)
+      : source_(std::move(source)), base_dir_(std::move(base_dir)), overrides_(std::move(overrides)) {}
+
+  SceneSpec Parse(const YAML::Node& root);
+
+ private:
+  SourceLoc Loc(const YAML::Node& node, const std::string& path) const {
+    for (auto it = overrides_.rbegin(); it != overrides_.rend(); ++it) {
+      if (IsUnder(path, it->path)) return {it->text, 0, 0};
+    }
+    if (node.IsDefined() && node.Mark().line >= 0) {
+      return {source_, node.Mark().line + 1, node.Mark().column + 1};
+    }
+    for (auto it = overrides_.rbegin(); it != overrides_.rend(); ++it) {
+      if (IsUnder(it->path, path)) return {it->text, 0, 0};
+    }
+    return {source_, 0, 0};
+  }
+
+  [[noreturn]] void Fail(const YAML::Node& node, const std::string& path,
+                         const std::string& message) const {
+    const SourceLoc loc = Loc(node, path);
+    throw SceneError(loc.source, loc.line, loc.column, path, message);
+  }
+
+  // Map with only `allowed` keys, each at most once.
+  void ExpectMap(const YAML::Node& n, const std::string& path,
+                 const std::vector<std::string>& allowed) const {
+    if (!n.IsMap()) Fail(n, path, "expected a map with keys " + Join(allowed) + ", got " + Describe(n));
+    std::set<std::string> seen;
+    for (const auto& kv : n) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+        Fail(kv.first, Child(path, key),
+             "unknown key '" + key + "' (expected one of: " + Join(allowed) + ")");
+      }
+      if (!seen.insert(key).second) Fail(kv.first, Child(path, key), "duplicate key '" + key + "'");
+    }
+  }
+
+  YAML::Node Need(const YAML::Node& map, const std::string& path, const std::string& key) const {
+    const YAML::Node n = map[key];
+    if (!n.IsDefined()) Fail(map, Child(path, key), "missing required key '" + key + "'");
+    return n;
+  }
+
+  Real Number(const YAML::Node& n, const std::string& path, const std::string& unit) const {
+    Real v = 0;
+    if (!n.IsScalar() || !YAML::convert<Real>::decode(n, v) || !std::isfinite(v)) {
+      Fail(n, path, "expected a number [" + unit + "], got " + Describe(n));
+    }
+    return v;
+  }
+
+  // A number in the interval (lo, hi) with open/closed ends; infinite ends print as > or >=.
+  Real Ranged(const YAML::Node& n, const std::string& path, const std::string& unit, Real lo,
+              bool lo_closed, Real hi, bool hi_closed) const {
+    const Real v = Number(n, path, unit);
+    const bool ok = (lo_closed ? v >= lo : v > lo) && (hi_closed ? v <= hi : v < hi);
+    if (!ok) {
+      std::string range;
+      if (hi == kInf) {
+        range = std::string(lo_closed ? ">= " : "> ") + Num(lo);
+      } else {
+        range = std::string("in ") + (lo_closed ? "[" : "(") + Num(lo) + ", " + Num(hi) +
+                (hi_closed ? "]" : ")");
+      }
+      Fail(n, path, "must be " + range + " [" + unit + "], got " + n.Scalar());
+    }
+    return v;
+  }
+  Real Positive(const YAML::Node& n, const std::string& path, const std::string& unit) const {
+    return Ranged(n, path, unit, 0, false, kInf, false);
+  }
+  Real NonNegative(const YAML::Node& n, const std::string& path, const std::string& unit) const {
+    return Ranged(n, path, unit, 0, true, kInf, false);
+  }
+
+  int64_t Integer(const YAML::Node& n, const std::string& path, int64_t lo, int64_t hi) const {
+    long long v = 0;
+    if (!n.IsScalar() || !YAML::convert<long long>::decode(n, v)) {
+      Fail(n, path, "expected an integer, got " + Describe(n));
+    }
+    if (v < lo || v > hi) {
+      Fail(n, path,
+           "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+               n.Scalar());
+    }
+    return v;
+  }
+
+  bool Bool(const YAML::Node& n, const std::string& path) const {
+    bool v = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) {
+      Fail(n, path, "expected true or false, got " + Describe(n));
+    }
+    return v;
+  }
+
+  std::string String(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsScalar() || n.Scalar().empty()) Fail(n, path, "expected a string, got " + Describe(n));
+    return n.Scalar();
+  }
+
+  // [A-Za-z0-9_-]+ : used in file names and HDF5 group names.
+  std::string Identifier(const YAML::Node& n, const std::string& path) const {
+    const std::string s = String(n, path);
+    for (char c : s) {
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') {
+        Fail(n, path, "'" + s + "' may contain only letters, digits, '_' and '-'");
+      }
+    }
+    return s;
+  }
+
+  template <class E, size_t N>
+  E Enum(const YAML::Node& n, const std::string& path, const EnumName<E> (&table)[N],
+         size_t count = N) const {
+    std::vector<std::string> names;
+    for (size_t i = 0; i < count; ++i) names.push_back(table[i].name);
+    if (!n.IsScalar()) Fail(n, path, "expected one of: " + Join(names) + ", got " + Describe(n));
+    for (size_t i = 0; i < count; ++i) {
+      if (n.Scalar() == table[i].name) return table[i].value;
+    }
+    Fail(n, path, "unknown value '" + n.Scalar() + "' (expected one of: " + Join(names) + ")");
+  }
+
+  // A point (`position`) or vector: 3 numbers in 3-D; 2 numbers, or 3 with z = 0, in 2-D.
+  Vec3 Vector(const YAML::Node& n, const std::string& path, const std::string& unit) const {
+    const bool two = dim_ == 2;
+    const std::string expected = two ? "a list of 2 numbers (or 3 with z = 0) [" + unit + "]"
+                                     : "a list of 3 numbers [" + unit + "]";
+    const size_t size = n.IsSequence() ? n.size() : 0;
+    if (!n.IsSequence() || !(size == 3 || (two && size == 2))) {
+      Fail(n, path, "expected " + expected + ", got " + Describe(n));
+    }
+    Vec3 v = Vec3::Zero();
+    for (size_t i = 0; i < size; ++i) v[i] = Number(n[i], Index(path, i), unit);
+    if (two && v.z() != 0) Fail(n, path, "in 2-D the z component must be 0, got " + Num(v.z()));
+    return v;
+  }
+
+  Wall ParseWall(const YAML::Node& n, const std::string& path) const;
+  MaterialSpec ParseMaterial(const YAML::Node& n, const std::string& path) const;
+  RegionShape ParseRegion(const YAML::Node& n, const std::string& path) const;
+  BodySpec ParseBody(const YAML::Node& n, const std::string& path, const SceneSpec& spec) const;
+
+  std::string source_;
+  std::string base_dir_;
+  std::vector<AppliedOverride> overrides_;
+  int dim_ = 3;
+};
+
+Wall Parser::ParseWall(const YAML::Node& n, const std::string& path) const {
+  Wall wall;
+  if (n.IsScalar()) {
+    if (n.Scalar() == "friction") {
+      Fail(n, path, "a friction wall needs a coefficient: write {friction: 0.3}");
+    }
+    wall.kind = Enum(n, path, kWallNames, 3);  // open, slip, no_slip
+    return wall;
+  }
+  ExpectMap(n, path, {"type", "friction", "separable"});
+  if (n["type"]) {
+    wall.kind = Enum(n["type"], Child(path, "type"), kWallNames);
+  } else if (n["friction"]) {
+    wall.kind = WallKind::kFriction;
+  } else {
+    Fail(n, Child(path, "type"), "missing required key 'type'");
+  }
+  if (wall.kind == WallKind::kFriction) {
+    wall.friction = NonNegative(Need(n, path, "friction"), Child(path, "friction"), "-");
+  } else if (n["friction"]) {
+    Fail(n["friction"], Child(path, "friction"),
+         "friction applies only to walls of type friction (this wall is " +
+             std::string(NameOf(kWallNames, wall.kind)) + ")");
+  }
+  if (n["separable"]) {
+    if (wall.kind != WallKind::kSlip && wall.kind != WallKind::kFriction) {
+      Fail(n["separable"], Child(path, "separable"),
+           "separable applies only to slip and friction walls");
+    }
+    wall.separable = Bool(n["separable"], Child(path, "separable"));
+  }
+  return wall;
+}
+
+MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path) const {
+  MaterialSpec m;
+  m.loc = Loc(n, path);
+  ExpectMap(n, path,
+            {"model", "density", "youngs_modulus", "poisson_ratio", "bulk_modulus", "shear_modulus"});
+  const YAML::Node model = Need(n, path, "model");
+  std::vector<std::string> names;
+  for (const MaterialKind& k : MaterialKinds()) names.push_back(k.name);
+  if (!model.IsScalar()) Fail(model, Child(path, "model"), "expected one of: " + Join(names));
+  bool found = false;
+  for (const MaterialKind& k : MaterialKinds()) {
+    if (model.Scalar() == k.name) {
+      m.model = k.model;
+      found = true;
+    }
+  }
+  if (!found) {
+    Fail(model, Child(path, "model"),
+         "unknown material model '" + model.Scalar() + "' (expected one of: " + Join(names) + ")");
+  }
+  m.density = Positive(Need(n, path, "density"), Child(path, "density"), "kg/m^3");
+
+  const bool kg = n["bulk_modulus"] || n["shear_modulus"];
+  const bool enu = n["youngs_modulus"] || n["poisson_ratio"];
+  if (kg && enu) {
+    Fail(n, path,
+         "give either (bulk_modulus, shear_modulus) or (youngs_modulus, poisson_ratio), not both");
+  }
+  if (!kg && !enu) {
+    Fail(n, path,
+         "missing elastic constants: give (bulk_modulus, shear_modulus) or (youngs_modulus, "
+         "poisson_ratio)");
+  }
+  if (kg) {
+    m.bulk_modulus = Positive(Need(n, path, "bulk_modulus"), Child(path, "bulk_modulus"), "Pa");
+    m.shear_modulus = Positive(Need(n, path, "shear_modulus"), Child(path, "shear_modulus"), "Pa");
+  } else {
+    m.given_as_youngs = true;
+    m.youngs_modulus =
+        Positive(Need(n, path, "youngs_modulus"), Child(path, "youngs_modulus"), "Pa");
+    m.poisson_ratio = Ranged(Need(n, path, "poisson_ratio"), Child(path, "poisson_ratio"), "-",
+                             -1, false, 0.5, false);
+    // Isotropic elasticity: K = E / (3 (1 - 2 nu)), G = E / (2 (1 + nu))
+    // (Bonet & Wood 2008, eqs. (6.36)-(6.37) in Lame form).
+    m.bulk_modulus = m.youngs_modulus / (3.0 * (1.0 - 2.0 * m.poisson_ratio));
+    m.shear_modulus = m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio));
+  }
+  return m;
+}
+
+// Is the closed polyline simple (no two non-adjacent edges touch)? O(n^2), n is small.
+bool IsSimplePolygon(const std::vector<std::array<Real, 2>>& p) {
+  const size_t n = p.size();
+  auto orient = [](const std::array<Real, 2>& a, const std::array<Real, 2>& b,
+                   const std::array<Real, 2>& c) {
+    const Real o = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    return (o > 0) - (o < 0);
+  };
+  auto on_segment = [](const std::array<Real, 2>& a, const std::array<Real, 2>& b,
+                       const std::array<Real, 2>& c) {  // c collinear with ab: within its box?
+    return std::min(a[0], b[0]) <= c[0] && c[0] <= std::max(a[0], b[0]) &&
+           std::min(a[1], b[1]) <= c[1] && c[1] <= std::max(a[1], b[1]);
+  };
+  auto intersect = [&](const std::array<Real, 2>& a, const std::array<Real, 2>& b,
+                       const std::array<Real, 2>& c, const std::array<Real, 2>& d) {
+    const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+    if (o1 != o2 && o3 != o4) return true;
+    return (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
+           (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b));
+  };
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
+      if (adjacent) {
+        // Adjacent edges share one vertex; they must not fold back onto each other.
+        const size_t a = i == 0 && j == n - 1 ? j : i;  // edge a ends where the next starts
+        const auto& p0 = p[a];
+        const auto& p1 = p[(a + 1) % n];
+        const auto& p2 = p[(a + 2) % n];
+        if (orient(p0, p1, p2) == 0 &&
+            (p2[0] - p1[0]) * (p1[0] - p0[0]) + (p2[1] - p1[1]) * (p1[1] - p0[1]) <= 0) {
+          return false;
+        }
+        continue;
+      }
+      if (intersect(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n])) return false;
+    }
+  }
+  return true;
+}
+
+RegionShape Parser::ParseRegion(const YAML::Node& n, const std::string& path) const {
+  const std::vector<std::string> kinds = {"box", "sphere", "cylinder", "polygon", "mesh"};
+  ExpectMap(n, path, kinds);
+  if (n.size() != 1) {
+    Fail(n, path,
+         "expected exactly one of: " + Join(kinds) + ", got " + std::to_string(n.size()));
+  }
+  const std::string kind = n.begin()->first.Scalar();
+  const YAML::Node s = n.begin()->second;
+  const std::string p = Child(path, kind);
+  if (kind == "box") {
+    ExpectMap(s, p, {"min", "max"});
+    BoxRegion box;
+    box.min = Vector(Need(s, p, "min"), Child(p, "min"), "m");
+    box.max = Vector(Need(s, p, "max"), Child(p, "max"), "m");
+    for (int a = 0; a < dim_; ++a) {
+      if (!(box.max[a] > box.min[a])) {
+        Fail(s["max"], Child(p, "max"), "must exceed min in every component [m]");
+      }
+    }
+    return box;
+  }
+  if (kind == "sphere") {
+    ExpectMap(s, p, {"center", "radius"});
+    SphereRegion sphere;
+    sphere.center = Vector(Need(s, p, "center"), Child(p, "center"), "m");
+    sphere.radius = Positive(Need(s, p, "radius"), Child(p, "radius"), "m");
+    return sphere;
+  }
+  if (kind == "cylinder") {
+    if (dim_ == 2) Fail(n.begin()->first, p, "cylinder regions are 3-D only (in 2-D use box, sphere or polygon)");
+    ExpectMap(s, p, {"base", "top", "radius"});
+    CylinderRegion cyl;
+    cyl.base = Vector(Need(s, p, "base"), Child(p, "base"), "m");
+    cyl.top = Vector(Need(s, p, "top"), Child(p, "top"), "m");
+    cyl.radius = Positive(Need(s, p, "radius"), Child(p, "radius"), "m");
+    if (cyl.top == cyl.base) Fail(s["top"], Child(p, "top"), "must differ from base");
+    return cyl;
+  }
+  if (kind == "polygon") {
+    ExpectMap(s, p, {"points", "z"});
+    PolygonRegion poly;
+    const YAML::Node pts = Need(s, p, "points");
+    const std::string pp = Child(p, "points");
+    if (!pts.IsSequence() || pts.size() < 3) {
+      Fail(pts, pp, "expected a list of at least 3 [x, y] points [m], got " + Describe(pts));
+    }
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const YAML::Node q = pts[i];
+      if (!q.IsSequence() || q.size() != 2) {
+        Fail(q, Index(pp, i), "expected a list of 2 numbers [x, y] [m], got " + Describe(q));
+      }
+      poly.points.push_back({Number(q[0], Index(Index(pp, i), 0), "m"),
+                             Number(q[1], Index(Index(pp, i), 1), "m")});
+    }
+    if (!IsSimplePolygon(poly.points)) {
+      Fail(pts, pp, "the polygon must be simple (its edges may not cross or touch)");
+    }
+    if (dim_ == 2) {
+      if (s["z"]) Fail(s["z"], Child(p, "z"), "z is not allowed in 2-D (particles lie in z = 0)");
+    } else {
+      const YAML::Node z = Need(s, p, "z");
+      if (!z.IsSequence() || z.size() != 2) {
+        Fail(z, Child(p, "z"), "expected a list of 2 numbers [z0, z1] [m], got " + Describe(z));
+      }
+      poly.z0 = Number(z[0], Index(Child(p, "z"), 0), "m");
+      poly.z1 = Number(z[1], Index(Child(p, "z"), 1), "m");
+      if (!(poly.z1 > poly.z0)) Fail(z, Child(p, "z"), "z1 must exceed z0 [m]");
+    }
+    return poly;
+  }
+  // mesh
+  if (dim_ == 2) Fail(n.begin()->first, p, "mesh regions are 3-D only");
+  ExpectMap(s, p, {"file", "scale", "translate"});
+  MeshRegion mesh;
+  const YAML::Node file = Need(s, p, "file");
+  const std::filesystem::path f = String(file, Child(p, "file"));
+  mesh.file = (f.is_absolute() ? f : std::filesystem::path(base_dir_) / f).lexically_normal().string();
+  mesh.file_loc = Loc(file, Child(p, "file"));
+  if (s["scale"]) mesh.scale = Positive(s["scale"], Child(p, "scale"), "-");
+  if (s["translate"]) mesh.translate = Vector(s["translate"], Child(p, "translate"), "m");
+  return mesh;
+}
+
+BodySpec Parser::ParseBody(const YAML::Node& n, const std::string& path,
+                           const SceneSpec& spec) const {
+  BodySpec b;
+  b.loc = Loc(n, path);
+  ExpectMap(n, path,
+            {"name", "material", "region", "particles_per_cell", "jitter", "seed", "velocity",
+             "initial_stress", "tractions"});
+  b.name = Identifier(Need(n, path, "name"), Child(path, "name"));
+  const YAML::Node mat = Need(n, path, "material");
+  b.material = String(mat, Child(path, "material"));
+  std::vector<std::string> defined;
+  b.material_index = -1;
+  for (size_t i = 0; i < spec.materials.size(); ++i) {
+    defined.push_back(spec.materials[i].name);
+    if (spec.materials[i].name == b.material) b.material_index = static_cast<int>(i);
+  }
+  if (b.material_index < 0) {
+    Fail(mat, Child(path, "material"),
+         "unknown material '" + b.material + "' (defined: " + Join(defined) + ")");
+  }
+  const YAML::Node region = Need(n, path, "region");
+  b.region_loc = Loc(region, Child(path, "region"));
+  b.region = ParseRegion(region, Child(path, "region"));
+  if (n["particles_per_cell"]) {
+    b.particles_per_cell = static_cast<int>(
+        Integer(n["particles_per_cell"], Child(path, "particles_per_cell"), 1, 8));
+  }
+  if (n["jitter"]) b.jitter = Ranged(n["jitter"], Child(path, "jitter"), "-", 0, true, 1, false);
+  if (n["seed"]) {
+    b.seed = static_cast<uint64_t>(
+        Integer(n["seed"], Child(path, "seed"), 0, std::numeric_limits<int64_t>::max()));
+  }
+  if (n["velocity"]) b.velocity = Vector(n["velocity"], Child(path, "velocity"), "m/s");
+  if (n["initial_stress"]) {
+    const YAML::Node is = n["initial_stress"];
+    const std::string ip = Child(path, "initial_stress");
+    ExpectMap(is, ip, {"geostatic"});
+    const YAML::Node geo = Need(is, ip, "geostatic");
+    const std::string gp = Child(ip, "geostatic");
+    ExpectMap(geo, gp, {"k0"});
+    b.geostatic_k0 = Positive(Need(geo, gp, "k0"), Child(gp, "k0"), "-");
+    if (spec.gravity.norm() == 0) {
+      Fail(geo, gp, "a geostatic initial stress needs a non-zero gravity");
+    }
+    const MaterialSpec& m = spec.materials[b.material_index];
+    const MaterialKind& kind = FindMaterialKind(m.model);
+    if (!kind.allows_geostatic) {
+      Fail(geo, gp,
+           "a geostatic initial stress is not available for material '" + m.name + "' (model " +
+               kind.name + ": its stress follows from the deformation gradient)");
+    }
+  }
+  if (n["tractions"]) {
+    const YAML::Node ts = n["tractions"];
+    const std::string tp = Child(path, "tractions");
+    if (!ts.IsSequence()) Fail(ts, tp, "expected a list of {face, traction}, got " + Describe(ts));
+    for (size_t i = 0; i < ts.size(); ++i) {
+      const std::string ep = Index(tp, i);
+      ExpectMap(ts[i], ep, {"face", "traction"});
+      TractionSpec t;
+      const YAML::Node face = Need(ts[i], ep, "face");
+      std::vector<std::string> faces;
+      for (int f = 0; f < 2 * dim_; ++f) faces.push_back(FaceName(static_cast<Face>(f)));
+      const auto it = face.IsScalar() ? std::find(faces.begin(), faces.end(), face.Scalar())
+                                      : faces.end();
+      if (it == faces.end()) {
+        Fail(face, Child(ep, "face"),
+             "expected one of: " + Join(faces) + ", got " + Describe(face));
+      }
+      t.face = static_cast<Face>(it - faces.begin());
+      t.traction = Vector(Need(ts[i], ep, "traction"), Child(ep, "traction"), "Pa");
+      b.tractions.push_back(t);
+    }
+  }
+  return b;
+}
+
+SceneSpec Parser::Parse(const YAML::Node& root) {
+  SceneSpec spec;
+  const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
+                                        "grid",   "domain",    "materials", "bodies",  "output"};
+  if (!root.IsDefined() || root.IsNull()) {
+    throw SceneError(source_, 0, 0, "", "the scene is empty (expected a map with keys " + Join(top) + ")");
+  }
+  ExpectMap(root, "", top);
+  spec.name = Identifier(Need(root, "", "name"), "name");
+  spec.dimension = dim_ = static_cast<int>(Integer(Need(root, "", "dimension"), "dimension", 2, 3));
+
+  {
+    const YAML::Node t = Need(root, "", "time");
+    ExpectMap(t, "time", {"end", "cfl", "min_dt", "max_dt", "fixed_dt"});
+    spec.time.end = Positive(Need(t, "time", "end"), "time.end", "s");
+    if (t["cfl"]) spec.time.cfl = Ranged(t["cfl"], "time.cfl", "-", 0, false, 1, true);
+    if (t["min_dt"]) spec.time.min_dt = NonNegative(t["min_dt"], "time.min_dt", "s");
+    if (t["max_dt"]) spec.time.max_dt = Positive(t["max_dt"], "time.max_dt", "s");
+    if (t["fixed_dt"]) spec.time.fixed_dt = NonNegative(t["fixed_dt"], "time.fixed_dt", "s");
+    if (spec.time.max_dt < spec.time.min_dt) {
+      Fail(t["max_dt"] ? t["max_dt"] : t, "time.max_dt",
+           "must be >= time.min_dt (" + Num(spec.time.min_dt) + " s)");
+    }
+  }
+  if (root["gravity"]) spec.gravity = Vector(root["gravity"], "gravity", "m/s^2");
+  if (root["gravity_ramp"]) spec.gravity_ramp = NonNegative(root["gravity_ramp"], "gravity_ramp", "s");
+
+  {
+    const YAML::Node g = Need(root, "", "grid");
+    ExpectMap(g, "grid", {"cell_size", "shape_function", "transfer", "flip_ratio", "update"});
+    spec.grid.cell_size = Positive(Need(g, "grid", "cell_size"), "grid.cell_size", "m");
+    if (g["shape_function"]) {
+      spec.grid.shape_function = Enum(g["shape_function"], "grid.shape_function", kShapeNames);
+    }
+    if (g["transfer"]) spec.grid.transfer = Enum(g["transfer"], "grid.transfer", kTransferNames);
+    if (g["flip_ratio"]) {
+      if (spec.grid.transfer != TransferScheme::kPicFlip) {
+        Fail(g["flip_ratio"], "grid.flip_ratio",
+             std::string("flip_ratio applies only to transfer: pic_flip (transfer is ") +
+                 NameOf(kTransferNames, spec.grid.transfer) + ")");
+      }
+      spec.grid.flip_ratio = Ranged(g["flip_ratio"], "grid.flip_ratio", "-", 0, true, 1, true);
+    }
+    if (g["update"]) spec.grid.update = Enum(g["update"], "grid.update", kUpdateNames);
+  }
+
+  {
+    const YAML::Node d = Need(root, "", "domain");
+    ExpectMap(d, "domain", {"min", "max", "walls", "on_exit"});
+    spec.domain.min = Vector(Need(d, "domain", "min"), "domain.min", "m");
+    spec.domain.max = Vector(Need(d, "domain", "max"), "domain.max", "m");
+    for (int a = 0; a < dim_; ++a) {
+      if (!(spec.domain.max[a] > spec.domain.min[a])) {
+        Fail(d["max"], "domain.max", "must exceed domain.min in every component [m]");
+      }
+    }
+    if (d["walls"]) {
+      const YAML::Node w = d["walls"];
+      std::vector<std::string> faces;
+      for (int f = 0; f < kFaceCount; ++f) faces.push_back(FaceName(static_cast<Face>(f)));
+      ExpectMap(w, "domain.walls", faces);
+      for (const auto& kv : w) {
+        const std::string face = kv.first.Scalar();
+        const int f = static_cast<int>(std::find(faces.begin(), faces.end(), face) - faces.begin());
+        if (dim_ == 2 && f >= 4) {
+          Fail(kv.first, "domain.walls." + face,
+               "z walls are not allowed in 2-D (plane strain has no z faces)");
+        }
+        spec.domain.walls[f] = ParseWall(kv.second, "domain.walls." + face);
+      }
+    }
+    if (d["on_exit"]) spec.domain.on_exit = Enum(d["on_exit"], "domain.on_exit", kExitNames);
+  }
+
+  {
+    const YAML::Node ms = Need(root, "", "materials");
+    if (!ms.IsMap() || ms.size() == 0) {
+      Fail(ms, "materials", "expected a non-empty map of material name -> parameters, got " + Describe(ms));
+    }
+    std::set<std::string> seen;
+    for (const auto& kv : ms) {
+      const std::string name = Identifier(kv.first, "materials");
+      const std::string p = Child("materials", name);
+      if (!seen.insert(name).second) Fail(kv.first, p, "duplicate material name '" + name + "'");
+      MaterialSpec m = ParseMaterial(kv.second, p);
+      m.name = name;
+      spec.materials.push_back(m);
+    }
+  }
+
+  {
+    const YAML::Node bs = Need(root, "", "bodies");
+    if (!bs.IsSequence() || bs.size() == 0) {
+      Fail(bs, "bodies", "expected a non-empty list of bodies, got " + Describe(bs));
+    }
+    for (size_t i = 0; i < bs.size(); ++i) {
+      BodySpec b = ParseBody(bs[i], Index("bodies", i), spec);
+      for (size_t j = 0; j < spec.bodies.size(); ++j) {
+        if (spec.bodies[j].name == b.name) {
+          Fail(bs[i]["name"], Child(Index("bodies", i), "name"),
+               "duplicate body name '" + b.name + "' (also bodies[" + std::to_string(j) + "])");
+        }
+      }
+      spec.bodies.push_back(std::move(b));
+    }
+  }
+
+  if (root["output"]) {
+    const YAML::Node o = root["output"];
+    ExpectMap(o, "output", {"every", "vdb", "energy"});
+    if (o["every"]) spec.output.every = NonNegative(o["every"], "output.every", "s");
+    if (o["vdb"]) spec.output.vdb = Bool(o["vdb"], "output.vdb");
+    if (o["energy"]) spec.output.energy = Bool(o["energy"], "output.energy");
+  }
+  return spec;
+}
+
+// --- Writer ---------------------------------------------------------------------------------
+
+void EmitVector(YAML::Emitter& e, const Vec3& v, int dim) {
+  e << YAML::Flow << YAML::BeginSeq;
+  for (int i = 0; i < dim; ++i) e << Num(v[i]);
+  e << YAML::EndSeq;
+}
+
+void EmitWall(YAML::Emitter& e, const Wall& w) {
+  const char* kind = NameOf(kWallNames, w.kind);
+  if (w.kind == WallKind::kOpen || w.kind == WallKind::kNoSlip ||
+      (w.kind == WallKind::kSlip && w.separable)) {
+    e << kind;
+    return;
+  }
+  e << YAML::Flow << YAML::BeginMap << YAML::Key << "type" << YAML::Value << kind;
+  if (w.kind == WallKind::kFriction) e << YAML::Key << "friction" << YAML::Value << Num(w.friction);
+  e << YAML::Key << "separable" << YAML::Value << w.separable << YAML::EndMap;
+}
+
+void EmitRegion(YAML::Emitter& e, const RegionShape& region, int dim) {
+  e << YAML::BeginMap;
+  if (const auto* box = std::get_if<BoxRegion>(&region)) {
+    e << YAML::Key << "box" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "min" << YAML::Value;
+    EmitVector(e, box->min, dim);
+    e << YAML::Key << "max" << YAML::Value;
+    EmitVector(e, box->max, dim);
+  } else if (const auto* sphere = std::get_if<SphereRegion>(&region)) {
+    e << YAML::Key << "sphere" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "center" << YAML::Value;
+    EmitVector(e, sphere->center, dim);
+    e << YAML::Key << "radius" << YAML::Value << Num(sphere->radius);
+  } else if (const auto* cyl = std::get_if<CylinderRegion>(&region)) {
+    e << YAML::Key << "cylinder" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "base" << YAML::Value;
+    EmitVector(e, cyl->base, dim);
+    e << YAML::Key << "top" << YAML::Value;
+    EmitVector(e, cyl->top, dim);
+    e << YAML::Key << "radius" << YAML::Value << Num(cyl->radius);
+  } else if (const auto* poly = std::get_if<PolygonRegion>(&region)) {
+    e << YAML::Key << "polygon" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "points" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const auto& q : poly->points) {
+      e << YAML::Flow << YAML::BeginSeq << Num(q[0]) << Num(q[1]) << YAML::EndSeq;
+    }
+    e << YAML::EndSeq;
+    if (dim == 3) {
+      e << YAML::Key << "z" << YAML::Value << YAML::Flow << YAML::BeginSeq << Num(poly->z0)
+        << Num(poly->z1) << YAML::EndSeq;
+    }
+  } else if (const auto* mesh = std::get_if<MeshRegion>(&region)) {
+    e << YAML::Key << "mesh" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "file" << YAML::Value << mesh->file;
+    e << YAML::Key << "scale" << YAML::Value << Num(mesh->scale);
+    e << YAML::Key << "translate" << YAML::Value;
+    EmitVector(e, mesh->translate, dim);
+  }
+  e << YAML::EndMap << YAML::EndMap;
+}
+
+}  // namespace
+
+SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
+                         const std::string& base_dir, const std::vector<std::string>& overrides) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw SceneError(source, e.mark.line + 1, e.mark.column + 1, "", "YAML syntax error: " + e.msg);
+  } catch (const YAML::Exception& e) {
+    throw SceneError(source, 0, 0, "", std::string("cannot parse YAML: ") + e.what());
+  }
+  std::vector<AppliedOverride> applied;
+  for (const std::string& o : overrides) {
+    if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+    applied.push_back(ApplyOverride(root, o));
+  }
+  Parser parser(source, base_dir, applied);
+  try {
+    return parser.Parse(root);
+  } catch (const YAML::Exception& e) {  // defensive: the parser checks types before converting
+    throw SceneError(source, e.mark.line + 1, e.mark.column + 1, "", e.what());
+  }
+}
+
+std::string SceneSpecToYaml(const SceneSpec& spec) {
+  const int dim = spec.dimension;
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "name" << YAML::Value << spec.name;
+  e << YAML::Key << "dimension" << YAML::Value << dim;
+
+  e << YAML::Key << "time" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "end" << YAML::Value << Num(spec.time.end);
+  e << YAML::Key << "cfl" << YAML::Value << Num(spec.time.cfl);
+  e << YAML::Key << "min_dt" << YAML::Value << Num(spec.time.min_dt);
+  e << YAML::Key << "max_dt" << YAML::Value << Num(spec.time.max_dt);
+  e << YAML::Key << "fixed_dt" << YAML::Value << Num(spec.time.fixed_dt);
+  e << YAML::EndMap;
+  e << YAML::Key << "gravity" << YAML::Value;
+  EmitVector(e, spec.gravity, dim);
+  e << YAML::Key << "gravity_ramp" << YAML::Value << Num(spec.gravity_ramp);
+
+  e << YAML::Key << "grid" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "cell_size" << YAML::Value << Num(spec.grid.cell_size);
+  e << YAML::Key << "shape_function" << YAML::Value
+    << NameOf(kShapeNames, spec.grid.shape_function);
+  e << YAML::Key << "transfer" << YAML::Value << NameOf(kTransferNames, spec.grid.transfer);
+  if (spec.grid.transfer == TransferScheme::kPicFlip) {
+    e << YAML::Key << "flip_ratio" << YAML::Value << Num(spec.grid.flip_ratio);
+  }
+  e << YAML::Key << "update" << YAML::Value << NameOf(kUpdateNames, spec.grid.update);
+  e << YAML::EndMap;
+
+  e << YAML::Key << "domain" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "min" << YAML::Value;
+  EmitVector(e, spec.domain.min, dim);
+  e << YAML::Key << "max" << YAML::Value;
+  EmitVector(e, spec.domain.max, dim);
+  e << YAML::Key << "walls" << YAML::Value << YAML::BeginMap;
+  for (int f = 0; f < 2 * dim; ++f) {
+    e << YAML::Key << FaceName(static_cast<Face>(f)) << YAML::Value;
+    EmitWall(e, spec.domain.walls[f]);
+  }
+  e << YAML::EndMap;
+  e << YAML::Key << "on_exit" << YAML::Value << NameOf(kExitNames, spec.domain.on_exit);
+  e << YAML::EndMap;
+
+  e << YAML::Key << "materials" << YAML::Value << YAML::BeginMap;
+  for (const MaterialSpec& m : spec.materials) {
+    e << YAML::Key << m.name << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "model" << YAML::Value << FindMaterialKind(m.model).name;
+    e << YAML::Key << "density" << YAML::Value << Num(m.density);
+    if (m.given_as_youngs) {
+      e << YAML::Key << "youngs_modulus" << YAML::Value << Num(m.youngs_modulus);
+      e << YAML::Key << "poisson_ratio" << YAML::Value << Num(m.poisson_ratio);
+    } else {
+      e << YAML::Key << "bulk_modulus" << YAML::Value << Num(m.bulk_modulus);
+      e << YAML::Key << "shear_modulus" << YAML::Value << Num(m.shear_modulus);
+    }
+    e << YAML::EndMap;
+  }
+  e << YAML::EndMap;
+
+  e << YAML::Key << "bodies" << YAML::Value << YAML::BeginSeq;
+  for (const BodySpec& b : spec.bodies) {
+    e << YAML::BeginMap;
+    e << YAML::Key << "name" << YAML::Value << b.name;
+    e << YAML::Key << "material" << YAML::Value << b.material;
+    e << YAML::Key << "region" << YAML::Value;
+    EmitRegion(e, b.region, dim);
+    e << YAML::Key << "particles_per_cell" << YAML::Value << b.particles_per_cell;
+    e << YAML::Key << "jitter" << YAML::Value << Num(b.jitter);
+    e << YAML::Key << "seed" << YAML::Value << b.seed;
+    e << YAML::Key << "velocity" << YAML::Value;
+    EmitVector(e, b.velocity, dim);
+    if (b.geostatic_k0) {
+      e << YAML::Key << "initial_stress" << YAML::Value << YAML::Flow << YAML::BeginMap
+        << YAML::Key << "geostatic" << YAML::Value << YAML::BeginMap << YAML::Key << "k0"
+        << YAML::Value << Num(*b.geostatic_k0) << YAML::EndMap << YAML::EndMap;
+    }
+    e << YAML::Key << "tractions" << YAML::Value << YAML::BeginSeq;
+    for (const TractionSpec& t : b.tractions) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "face" << YAML::Value << FaceName(t.face)
+        << YAML::Key << "traction" << YAML::Value;
+      EmitVector(e, t.traction, dim);
+      e << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+    e << YAML::EndMap;
+  }
+  e << YAML::EndSeq;
+
+  e << YAML::Key << "output" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "every" << YAML::Value << Num(spec.output.every);
+  e << YAML::Key << "vdb" << YAML::Value << spec.output.vdb;
+  e << YAML::Key << "energy" << YAML::Value << spec.output.energy;
+  e << YAML::EndMap;
+  e << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
+}
+
+}  // namespace surge

@@ -1,0 +1,150 @@
+// Scene spec: plain structs mirroring the scene file (docs/scene-reference.md), with every default
+// written here. scene_parser.cpp fills and validates them; scene_builder.cpp turns them into
+// Model + State. Positions carry the source location the builder needs for its own errors.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/math.h"
+#include "core/model.h"
+#include "materials/material_params.h"
+
+namespace surge {
+
+// Where a value came from: a file position (1-based) or a --set override (`source`).
+struct SourceLoc {
+  std::string source;  // file name, "<string>" or "--set key=value"
+  int line = 0;
+  int column = 0;
+};
+
+struct TimeSpec {
+  Real end = 0;         // required, > 0 [s]
+  Real cfl = 0.4;       // (0, 1] [-]
+  Real min_dt = 1e-12;  // >= 0 [s]
+  Real max_dt = 1e30;   // > 0 [s] (1e30 = unbounded)
+  Real fixed_dt = 0;    // >= 0 [s]; 0 = adaptive (CFL)
+};
+
+struct GridSpec {
+  Real cell_size = 0;  // required, > 0 [m]
+  ShapeFunction shape_function = ShapeFunction::kQuadraticBspline;
+  TransferScheme transfer = TransferScheme::kApic;
+  Real flip_ratio = 0.95;  // [0, 1]; only with transfer pic_flip
+  UpdateScheme update = UpdateScheme::kUsl;
+};
+
+struct DomainSpec {
+  Vec3 min = Vec3::Zero();            // required [m]
+  Vec3 max = Vec3::Zero();            // required [m], > min in each seeded component
+  std::array<Wall, kFaceCount> walls; // missing faces are open
+  ExitPolicy on_exit = ExitPolicy::kRemove;
+};
+
+// Material models known to the scene file; names and constructors live in the one table in
+// scene_builder.cpp (MaterialKinds()).
+enum class MaterialModel { kLinearElastic, kNeoHookean };
+
+struct MaterialSpec {
+  std::string name;  // the key under `materials`
+  MaterialModel model = MaterialModel::kLinearElastic;
+  Real density = 0;  // [kg/m^3]
+  // Elasticity is given either as (K, G) or as (E, nu); the parser fills K and G in both cases.
+  bool given_as_youngs = false;
+  Real bulk_modulus = 0;   // K [Pa]
+  Real shear_modulus = 0;  // G [Pa]
+  Real youngs_modulus = 0; // E [Pa] (given_as_youngs only)
+  Real poisson_ratio = 0;  // nu [-] (given_as_youngs only)
+  SourceLoc loc;
+};
+
+// Kinds of material model: one table (scene_builder.cpp) used by parser, writer and builder.
+struct MaterialKind {
+  const char* name;  // value of `model:` in the scene file
+  MaterialModel model;
+  bool allows_geostatic;  // the initial stress can be prescribed (not derived from F)
+  MaterialParams (*make_params)(const MaterialSpec&);
+};
+std::span<const MaterialKind> MaterialKinds();
+const MaterialKind& FindMaterialKind(MaterialModel model);
+
+struct BoxRegion {
+  Vec3 min = Vec3::Zero();  // [m]
+  Vec3 max = Vec3::Zero();  // [m]
+};
+struct SphereRegion {  // a disk in 2-D
+  Vec3 center = Vec3::Zero();  // [m]
+  Real radius = 0;             // [m]
+};
+struct CylinderRegion {  // 3-D only
+  Vec3 base = Vec3::Zero();  // centre of the base disk [m]
+  Vec3 top = Vec3::Zero();   // centre of the top disk [m]
+  Real radius = 0;           // [m]
+};
+struct PolygonRegion {  // simple polygon in the xy plane, extruded over [z0, z1] in 3-D
+  std::vector<std::array<Real, 2>> points;  // [m]
+  Real z0 = 0;                              // [m] (3-D only)
+  Real z1 = 0;                              // [m] (3-D only)
+};
+struct MeshRegion {  // 3-D only: the inside of a closed triangle mesh
+  std::string file;   // resolved path (relative paths are taken from the scene file's directory)
+  Real scale = 1;     // vertices are scaled, then translated [-]
+  Vec3 translate = Vec3::Zero();  // [m]
+  SourceLoc file_loc;
+};
+using RegionShape = std::variant<BoxRegion, SphereRegion, CylinderRegion, PolygonRegion, MeshRegion>;
+
+struct TractionSpec {
+  Face face = Face::kXMax;
+  Vec3 traction = Vec3::Zero();  // [Pa]
+};
+
+struct BodySpec {
+  std::string name;
+  std::string material;    // name, as written
+  int material_index = 0;  // into SceneSpec::materials
+  RegionShape region;
+  int particles_per_cell = 2;  // per direction, 1..8
+  Real jitter = 0;             // [0, 1) of a particle spacing
+  uint64_t seed = 1;           // jitter RNG seed
+  Vec3 velocity = Vec3::Zero();  // [m/s]
+  std::optional<Real> geostatic_k0;  // initial_stress: {geostatic: {k0}}
+  std::vector<TractionSpec> tractions;
+  SourceLoc loc;         // the body's map
+  SourceLoc region_loc;  // the `region` map
+};
+
+struct OutputSpec {
+  Real every = 0;  // [s]; 0 = first and last only
+  bool vdb = false;
+  bool energy = true;
+};
+
+struct SceneSpec {
+  std::string name;
+  int dimension = 3;
+  TimeSpec time;
+  Vec3 gravity = Vec3::Zero();  // [m/s^2]
+  Real gravity_ramp = 0;        // [s]
+  GridSpec grid;
+  DomainSpec domain;
+  std::vector<MaterialSpec> materials;  // in file order; Model::materials has the same order
+  std::vector<BodySpec> bodies;
+  OutputSpec output;
+};
+
+// Parses scene text into a validated spec. `source` names the text in errors; `base_dir` resolves
+// relative asset paths; `overrides` are "key.path=value" strings applied before validation.
+// Throws SceneError.
+SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
+                         const std::string& base_dir, const std::vector<std::string>& overrides);
+
+// The spec as YAML with every default written out; ParseSceneSpec reads it back to an equal spec.
+std::string SceneSpecToYaml(const SceneSpec& spec);
+
+}  // namespace surge
