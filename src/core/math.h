@@ -1,6 +1,8 @@
 // Surge math types: the only place Eigen/Core is named (STYLE H.2).
 #pragma once
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products
+#include <Eigen/LU>        // 3x3 determinants
 #include <cstdint>
 
 namespace surge {

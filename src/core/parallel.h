@@ -1,0 +1,36 @@
+// Thin wrappers over oneTBB so that every parallel loop has a thread-count-independent
+// decomposition where the result depends on it (deterministic reductions, STYLE H.4 / DESIGN §5).
+#pragma once
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstddef>
+
+namespace surge {
+
+// Runs f(i) for i in [0, n); order unspecified. f must only write data owned by i.
+template <typename F>
+void ParallelFor(size_t n, size_t grain, const F& f) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, std::max<size_t>(grain, 1)),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) f(i);
+                    });
+}
+
+// Number of fixed chunks used by deterministic reductions: independent of the thread count.
+inline constexpr size_t kReductionChunks = 64;
+
+// Splits [0, n) into kReductionChunks contiguous chunks and runs f(chunk, begin, end) in
+// parallel. Partial results stored per chunk and combined in chunk order are bitwise
+// reproducible for any thread count.
+template <typename F>
+void ParallelChunks(size_t n, const F& f) {
+  tbb::parallel_for(size_t{0}, kReductionChunks, [&](size_t c) {
+    const size_t begin = n * c / kReductionChunks;
+    const size_t end = n * (c + 1) / kReductionChunks;
+    f(c, begin, end);
+  });
+}
+
+}  // namespace surge

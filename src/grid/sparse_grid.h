@@ -1,0 +1,79 @@
+// Sparse background grid (DESIGN §5): the set of active blocks is an OpenVDB tree whose 8^3
+// leaves are the blocks (vdb_bridge.cpp); node data lives in our own per-block arrays indexed
+// [block * kBlockNodes + local]. Hot loops use the block and neighbour tables built here each
+// step, never an OpenVDB accessor per particle.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+
+namespace surge {
+
+inline constexpr int kBlockBits = 3;
+inline constexpr int kBlockDim = 1 << kBlockBits;  // nodes per block edge
+inline constexpr int kBlockNodes = kBlockDim * kBlockDim * kBlockDim;
+
+// Local node index inside a block; lz fastest.
+inline constexpr int LocalNode(int lx, int ly, int lz) { return (lx * kBlockDim + ly) * kBlockDim + lz; }
+
+class BlockTopology;  // OpenVDB Int32Tree behind a pimpl (vdb_bridge.cpp)
+
+// A block is needed by a particle whose stencil starts in it; `upper` bit d (0..2) says the
+// stencil also crosses into the +d neighbour (and all subsets of the set bits are touched).
+struct BlockRequest {
+  Vec3i block;          // block coordinate = node index >> kBlockBits
+  uint8_t upper = 0;    // crossing mask
+};
+
+struct SparseGrid {
+  SparseGrid();
+  ~SparseGrid();
+  SparseGrid(SparseGrid&&) noexcept;
+  SparseGrid& operator=(SparseGrid&&) noexcept;
+
+  // --- Topology, rebuilt every step by RebuildGrid. ---
+  std::vector<Vec3i> block_origin;                 // node index of local node (0,0,0)
+  std::vector<std::array<int32_t, 8>> neighbor;    // [b][ox + 2 oy + 4 oz]: block at origin + 8 o, or -1
+  std::array<std::vector<int32_t>, 8> colour;      // blocks by parity of their block coordinate
+  // --- Particle binning (indices into Particles), stable in particle index. ---
+  std::vector<int32_t> particle_block;  // owner block of each particle
+  std::vector<uint32_t> block_begin;    // size blocks+1: particles of block b are
+  std::vector<uint32_t> sorted;         //   sorted[block_begin[b] .. block_begin[b+1])
+  // --- Node fields, size blocks * kBlockNodes. ---
+  std::vector<Real> mass;           // lumped mass m_i [kg]                (2.12)
+  std::vector<Vec3> momentum;       // p_i [kg m/s]                        (2.12)
+  std::vector<Vec3> force;          // f_int + f_ext (without gravity) [N] (2.11)
+  std::vector<Vec3> velocity;       // v_{i,n} = p_i / m_i [m/s]           (2.13)
+  std::vector<Vec3> velocity_new;   // v_{i,n+1} after boundary conditions (2.14)
+
+  // --- Scratch reused by RebuildGrid (no allocation per step after warm-up). ---
+  std::vector<Vec3i> particle_block_coord;
+  std::vector<std::vector<BlockRequest>> chunk_requests;
+  std::vector<BlockRequest> requests;
+  std::vector<uint32_t> chunk_cursor;
+
+  std::unique_ptr<BlockTopology> topology;
+
+  size_t block_count() const { return block_origin.size(); }
+  size_t ActiveNodeCount() const;  // nodes with mass > 0
+};
+
+// Builds the topology for the given block requests (serial, deterministic: blocks are numbered
+// in tree order), the neighbour table and the colour lists, and sizes the node arrays (zeroed).
+void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid);
+
+// For each of n block coordinates, the block index (or -1 when the block is not active).
+void LookupBlocks(const SparseGrid& grid, const Vec3i* blocks, size_t n, int32_t* out);
+
+// Writes the grid's mass and velocity as a .vdb file (FloatGrid "mass", Vec3fGrid "velocity",
+// voxel size dx). Throws std::runtime_error naming the path on failure.
+void ExportGridVdb(const SparseGrid& grid, Real dx, const std::string& path);
+
+// OpenVDB library version string (for `surge info`).
+const char* OpenVdbVersion();
+
+}  // namespace surge

@@ -1,0 +1,138 @@
+// The only includer of OpenVDB (STYLE H.10): block topology as an Int32Tree whose leaves are the
+// 8^3 blocks, the block/neighbour tables, and .vdb export of grid fields.
+// Scheme measured in shared/notes/vdb-block-grid-spike.md: deduplicated leaf-level inserts, voxel 0
+// of each leaf holds the dense block index; the tree is rebuilt every step.
+#include <openvdb/openvdb.h>
+#include <tbb/parallel_for.h>
+
+#include <mutex>
+#include <stdexcept>
+
+#include "grid/sparse_grid.h"
+
+namespace surge {
+
+class BlockTopology {
+ public:
+  openvdb::Int32Tree tree{-1};
+};
+
+namespace {
+
+void InitOpenVdbOnce() {
+  static std::once_flag flag;
+  std::call_once(flag, [] { openvdb::initialize(); });
+}
+
+static_assert(openvdb::Int32Tree::LeafNodeType::DIM == kBlockDim,
+              "OpenVDB leaf edge must equal the block edge");
+
+openvdb::Coord ToCoord(const Vec3i& node) { return openvdb::Coord(node.x(), node.y(), node.z()); }
+
+}  // namespace
+
+SparseGrid::SparseGrid() : topology(std::make_unique<BlockTopology>()) {}
+SparseGrid::~SparseGrid() = default;
+SparseGrid::SparseGrid(SparseGrid&&) noexcept = default;
+SparseGrid& SparseGrid::operator=(SparseGrid&&) noexcept = default;
+
+void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid) {
+  InitOpenVdbOnce();
+  if (!grid.topology) grid.topology = std::make_unique<BlockTopology>();
+  auto& tree = grid.topology->tree;
+  tree.clear();
+  {
+    openvdb::tree::ValueAccessor<openvdb::Int32Tree> acc(tree);
+    for (const BlockRequest& r : requests) {
+      const Vec3i origin = r.block * kBlockDim;
+      for (int o = 0; o < 8; ++o) {
+        if ((o & ~r.upper) != 0) continue;  // only subsets of the crossing mask
+        const Vec3i n = origin + kBlockDim * Vec3i(o & 1, (o >> 1) & 1, (o >> 2) & 1);
+        acc.touchLeaf(ToCoord(n));
+      }
+    }
+  }
+  // Number the leaves in tree order; voxel 0 holds the index.
+  const size_t count = tree.leafCount();
+  grid.block_origin.resize(count);
+  int32_t index = 0;
+  for (auto leaf = tree.beginLeaf(); leaf; ++leaf) {
+    const openvdb::Coord o = leaf->origin();
+    grid.block_origin[index] = Vec3i(o.x(), o.y(), o.z());
+    leaf->setValueOn(0, index);
+    ++index;
+  }
+  grid.neighbor.resize(count);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 64), [&](const tbb::blocked_range<size_t>& r) {
+    openvdb::tree::ValueAccessor<const openvdb::Int32Tree> acc(tree);
+    for (size_t b = r.begin(); b != r.end(); ++b) {
+      for (int o = 0; o < 8; ++o) {
+        const Vec3i n = grid.block_origin[b] + kBlockDim * Vec3i(o & 1, (o >> 1) & 1, (o >> 2) & 1);
+        const auto* leaf = acc.probeConstLeaf(ToCoord(n));
+        grid.neighbor[b][o] = leaf ? leaf->getValue(0) : -1;
+      }
+    }
+  });
+  for (auto& c : grid.colour) c.clear();
+  for (size_t b = 0; b < count; ++b) {
+    const Vec3i bc = grid.block_origin[b] / kBlockDim;
+    const int c = (bc.x() & 1) | ((bc.y() & 1) << 1) | ((bc.z() & 1) << 2);
+    grid.colour[c].push_back(static_cast<int32_t>(b));
+  }
+  const size_t nodes = count * kBlockNodes;
+  grid.mass.assign(nodes, 0.0);
+  grid.momentum.assign(nodes, Vec3::Zero());
+  grid.force.assign(nodes, Vec3::Zero());
+  grid.velocity.resize(nodes);
+  grid.velocity_new.resize(nodes);
+}
+
+void LookupBlocks(const SparseGrid& grid, const Vec3i* blocks, size_t n, int32_t* out) {
+  const auto& tree = grid.topology->tree;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    openvdb::tree::ValueAccessor<const openvdb::Int32Tree> acc(tree);
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const auto* leaf = acc.probeConstLeaf(ToCoord(blocks[i] * kBlockDim));
+      out[i] = leaf ? leaf->getValue(0) : -1;
+    }
+  });
+}
+
+void ExportGridVdb(const SparseGrid& grid, Real dx, const std::string& path) {
+  InitOpenVdbOnce();
+  auto mass = openvdb::FloatGrid::create(0.0f);
+  auto vel = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.0f));
+  mass->setName("mass");
+  vel->setName("velocity");
+  const auto xform = openvdb::math::Transform::createLinearTransform(dx);
+  mass->setTransform(xform);
+  vel->setTransform(xform->copy());
+  vel->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  auto macc = mass->getAccessor();
+  auto vacc = vel->getAccessor();
+  for (size_t b = 0; b < grid.block_count(); ++b) {
+    for (int lx = 0; lx < kBlockDim; ++lx)
+      for (int ly = 0; ly < kBlockDim; ++ly)
+        for (int lz = 0; lz < kBlockDim; ++lz) {
+          const size_t i = b * kBlockNodes + LocalNode(lx, ly, lz);
+          if (grid.mass[i] <= 0) continue;
+          const Vec3i n = grid.block_origin[b] + Vec3i(lx, ly, lz);
+          const openvdb::Coord c(n.x(), n.y(), n.z());
+          macc.setValue(c, static_cast<float>(grid.mass[i]));
+          const Vec3& v = grid.velocity_new[i];
+          vacc.setValue(c, openvdb::Vec3f(float(v.x()), float(v.y()), float(v.z())));
+        }
+  }
+  try {
+    openvdb::io::File file(path);
+    openvdb::GridPtrVec grids{mass, vel};
+    file.write(grids);
+    file.close();
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot write grid file '" + path + "': " + e.what());
+  }
+}
+
+const char* OpenVdbVersion() { return openvdb::getLibraryVersionString(); }
+
+}  // namespace surge

@@ -1,0 +1,80 @@
+// Stress update dispatch: one std::visit per material group (STYLE H.4).
+#include "materials/update_stress.h"
+
+#include <array>
+
+#include "core/parallel.h"
+#include "materials/linear_elastic.h"
+#include "materials/neo_hookean.h"
+
+namespace surge {
+namespace {
+
+template <class... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
+}  // namespace
+
+void UpdateStress(const Model& model, const StepContext& ctx,
+                  const std::vector<Mat3>& velocity_gradient,
+                  const std::vector<MaterialGroup>& groups, Particles& P) {
+  const Real dt = ctx.dt;
+  for (const MaterialGroup& g : groups) {
+    const size_t count = g.end - g.begin;
+    std::visit(Overloaded{
+                   [&](const LinearElasticParams& params) {
+                     ParallelFor(count, 1024, [&](size_t k) {
+                       const size_t p = g.begin + k;
+                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
+                       P.F[p] = f * P.F[p];
+                       LinearElasticUpdate(params, Sym(f - Mat3::Identity()), P.stress[p],
+                                           P.strain[p]);
+                     });
+                   },
+                   [&](const NeoHookeanParams& params) {
+                     ParallelFor(count, 1024, [&](size_t k) {
+                       const size_t p = g.begin + k;
+                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
+                       P.F[p] = f * P.F[p];
+                       P.strain[p] += Sym(f - Mat3::Identity());
+                       P.stress[p] = NeoHookeanStress(params, P.F[p]);
+                     });
+                   },
+               },
+               model.materials[g.material].params);
+  }
+}
+
+Real StrainEnergyDensity(const Material& material, const Mat3& F, const Mat3& stress,
+                         const Mat3& strain) {
+  return std::visit(Overloaded{
+                        [&](const LinearElasticParams&) {
+                          return LinearElasticEnergy(stress, strain);
+                        },
+                        [&](const NeoHookeanParams& p) { return NeoHookeanEnergy(p, F); },
+                    },
+                    material.params);
+}
+
+Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,
+                  const Particles& P) {
+  Real total = 0;
+  for (const MaterialGroup& g : groups) {
+    const Material& mat = model.materials[g.material];
+    std::array<Real, kReductionChunks> partial{};
+    ParallelChunks(g.end - g.begin, [&](size_t c, size_t b, size_t e) {
+      Real sum = 0;
+      for (size_t p = g.begin + b; p < g.begin + e; ++p)
+        sum += StrainEnergyDensity(mat, P.F[p], P.stress[p], P.strain[p]) * P.volume0[p];
+      partial[c] = sum;
+    });
+    for (Real s : partial) total += s;
+  }
+  return total;
+}
+
+}  // namespace surge

@@ -1,0 +1,26 @@
+// Kinematics and stress update per material group (Mast 2013 eqs. (2.17)-(2.20)): one
+// std::visit per group, then a monomorphic parallel loop (no per-particle virtual call).
+#pragma once
+#include <vector>
+
+#include "core/model.h"
+#include "core/state.h"
+#include "core/step_context.h"
+
+namespace surge {
+
+// F_{n+1} = (I + dt L) F_n (2.18), then the group's constitutive update. Reads L, F, stress,
+// strain; writes F, stress, strain.
+void UpdateStress(const Model& model, const StepContext& ctx,
+                  const std::vector<Mat3>& velocity_gradient,
+                  const std::vector<MaterialGroup>& groups, Particles& particles);
+
+// Stored elastic energy sum psi V0 [J] (per metre of thickness in 2-D), summed in fixed chunks.
+Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,
+                  const Particles& particles);
+
+// Energy density of one particle [J/m^3 of reference volume].
+Real StrainEnergyDensity(const Material& material, const Mat3& F, const Mat3& stress,
+                         const Mat3& strain);
+
+}  // namespace surge

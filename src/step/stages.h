@@ -1,0 +1,22 @@
+// Stage adapters with the uniform StageFn signature; each calls one module function.
+#pragma once
+#include "step/step.h"
+
+namespace surge {
+
+void RebuildGridStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void ParticleToGridStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void GridUpdateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void GridToParticleUslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void GridToParticleMuslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void RemapMomentumStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void VelocityGradientStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void UpdateStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void DomainExitStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void CheckStateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void EnergyStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+
+// End-of-step energies of a state (also used by tests and the run summary).
+EnergyRecord ComputeEnergy(const Model& model, const State& state);
+
+}  // namespace surge

@@ -1,0 +1,91 @@
+// THE pipeline. Stage order follows the seed cycle (Mast 2013, Fig. 2.1, eqs. (2.12)-(2.22));
+// docs/architecture.md has a paragraph per stage.
+//
+//   USL : RebuildGrid -> ParticleToGrid -> GridUpdate -> GridToParticle (+ L_p) -> UpdateStress
+//   MUSL: RebuildGrid -> ParticleToGrid -> GridUpdate -> GridToParticle -> RemapMomentum
+//         -> VelocityGradient -> UpdateStress
+//   then: DomainExit -> CheckState -> Energy
+#include "step/step.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/parallel.h"
+#include "materials/update_stress.h"
+#include "step/stages.h"
+
+namespace surge {
+
+Pipeline MakePipeline(const Model& model) {
+  Pipeline p;
+  p.push_back({Stage::kRebuildGrid, RebuildGridStage});
+  p.push_back({Stage::kParticleToGrid, ParticleToGridStage});                  // (2.12)
+  p.push_back({Stage::kGridUpdate, GridUpdateStage});                          // (2.13)-(2.14)
+  if (model.scheme == UpdateScheme::kUsl) {
+    p.push_back({Stage::kGridToParticle, GridToParticleUslStage});             // (2.17), (2.22)
+  } else {
+    p.push_back({Stage::kGridToParticle, GridToParticleMuslStage});            // (2.22)
+    p.push_back({Stage::kRemapMomentum, RemapMomentumStage});                  // Sulsky 1995
+    p.push_back({Stage::kVelocityGradient, VelocityGradientStage});            // (2.17)
+  }
+  p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)
+  p.push_back({Stage::kDomainExit, DomainExitStage});
+  p.push_back({Stage::kCheckState, CheckStateStage});
+  if (model.output.energy) p.push_back({Stage::kEnergy, EnergyStage});
+  return p;
+}
+
+void Step(const Model& model, const Pipeline& pipeline, State& state, Workspace& work,
+          StepReport& report) {
+  StepContext ctx;
+  ctx.time = state.time;
+  ctx.dt = NextTimeStep(model, state);
+  ctx.dx = model.dx;
+  ctx.inv_dx = 1.0 / model.dx;
+  ctx.ramp = RampFactor(model, state.time);
+  ctx.gravity = ctx.ramp * model.gravity;
+  if (!(ctx.dt >= model.time.min_dt) || !std::isfinite(ctx.dt)) {
+    report.health = Health{HealthStatus::kTimeStepTooSmall, -1,
+                           "time step " + std::to_string(ctx.dt) + " s is below time.min_dt"};
+    return;
+  }
+
+  StageClock clock(report.stage_seconds);
+  for (const PipelineStage& stage : pipeline) {
+    stage.run(model, ctx, state, work, report);
+    clock.Lap(stage.stage);
+  }
+  state.time += ctx.dt;
+  state.dt = ctx.dt;
+  ++state.step;
+  report.energy.time = state.time;
+  report.energy.step = state.step;
+  report.energy.dt = ctx.dt;
+}
+
+Real NextTimeStep(const Model& model, const State& state) {
+  const Real remaining = model.time.end - state.time;
+  Real dt = model.time.fixed_dt;
+  if (dt <= 0) {
+    const Particles& P = state.particles;
+    Real max_speed = 0;
+    for (const MaterialGroup& g : state.groups) {
+      const Real c = WaveSpeed(model.materials[g.material]);
+      std::array<Real, kReductionChunks> partial{};
+      ParallelChunks(g.end - g.begin, [&](size_t chunk, size_t b, size_t e) {
+        Real vmax = 0;
+        for (size_t p = g.begin + b; p < g.begin + e; ++p) vmax = std::max(vmax, P.v[p].squaredNorm());
+        partial[chunk] = vmax;
+      });
+      const Real vmax = std::sqrt(*std::max_element(partial.begin(), partial.end()));
+      if (g.end > g.begin) max_speed = std::max(max_speed, c + vmax);
+    }
+    dt = max_speed > 0 ? model.time.cfl * model.dx / max_speed : model.time.max_dt;  // spec §1.7
+    dt = std::min(dt, model.time.max_dt);
+  }
+  // Land exactly on the end time; never take a sliver step afterwards.
+  if (remaining > 0 && dt > remaining) dt = remaining;
+  return dt;
+}
+
+}  // namespace surge

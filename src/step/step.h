@@ -1,0 +1,44 @@
+// The explicit MPM step (Mast 2013, Fig. 2.1): a pipeline of named, timed stages assembled once
+// from the Model (DESIGN §4). Read step.cpp first: it is the whole cycle.
+#pragma once
+#include <array>
+#include <vector>
+
+#include "core/model.h"
+#include "core/stage.h"
+#include "core/state.h"
+#include "core/step_context.h"
+#include "core/step_report.h"
+#include "step/workspace.h"
+
+namespace surge {
+
+struct StepReport {
+  StageSeconds stage_seconds{};  // cumulative wall time per stage [s]
+  EnergyRecord energy;           // end-of-step energies (when the energy stage is in the pipeline)
+  Health health;                 // first problem found by CheckState / DomainExit / time step
+  WallReport walls;              // wall reactions of the last step
+  int64_t removed_last_step = 0; // particles removed through open sides in the last step
+};
+
+using StageFn = void (*)(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+
+struct PipelineStage {
+  Stage stage;
+  StageFn run;
+};
+
+using Pipeline = std::vector<PipelineStage>;
+
+// The stages this model needs, in cycle order; unneeded stages are not in the list.
+Pipeline MakePipeline(const Model& model);
+
+// Time step for the next step: CFL rule dt = C dx / max_p (c_p + |v_p|) (spec §1.7), bounded by
+// max_dt, the fixed override and the remaining time to Model::time.end.
+Real NextTimeStep(const Model& model, const State& state);
+
+// Advances the state by one step. After it, report.health says whether the state is usable.
+void Step(const Model& model, const Pipeline& pipeline, State& state, Workspace& work,
+          StepReport& report);
+
+}  // namespace surge

@@ -1,0 +1,118 @@
+// P2G (Mast 2013 eq. (2.12)): mass, momentum (+ APIC affine term), internal and traction forces.
+// Blocks are processed colour by colour; a block accumulates its particles into a padded local
+// buffer and adds it into itself and its 7 upper neighbours (no atomics, fixed summation order).
+#include "core/check.h"
+#include "core/parallel.h"
+#include "transfer/dispatch.h"
+#include "transfer/stencil_loop.h"
+#include "transfer/transfer.h"
+
+namespace surge {
+namespace {
+
+struct NodeAccum {
+  Real m, px, py, pz, fx, fy, fz, pad;
+};
+
+// kFull: mass, momentum and force; otherwise momentum only (MUSL re-map).
+template <int kDim, class K, bool kApic, bool kFull>
+void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, size_t blk,
+                  std::vector<NodeAccum>& buf) {
+  using Pad = BlockPad<kDim, K>;
+  buf.assign(Pad::kSize, NodeAccum{});
+  const Vec3i origin = grid.block_origin[blk];
+  const Real dx = ctx.dx;
+  for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
+    const uint32_t p = grid.sorted[s];
+    const Vec3& x = P.x[p];
+    Stencil<kDim, K> st;
+    st.Compute(x, ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
+    const Vec3i lb = st.base - origin;
+    const Real m = P.mass[p];
+    const Vec3 mv = m * P.v[p];
+    Mat3 mC = Mat3::Zero();
+    if constexpr (kApic) mC = m * P.C[p];
+    // Internal force -V_p sigma_p grad N_ip with V_p = J V0 (2.11; sigma-bar m = tau V0).
+    Mat3 neg_vs = Mat3::Zero();
+    Vec3 fext = Vec3::Zero();
+    if constexpr (kFull) {
+      neg_vs = -(P.volume0[p] * P.F[p].determinant()) * P.stress[p];
+      fext = ctx.ramp * P.ext_force[p];  // particle tractions (App. B.2.9), ramped (App. B.2.3)
+    }
+    for (int i = 0; i < st.W; ++i)
+      for (int j = 0; j < st.W; ++j)
+        for (int k = 0; k < st.Wz; ++k) {
+          const Real w = st.Weight(i, j, k);
+          NodeAccum& a = buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + k)];
+          Vec3 mom = w * mv;
+          if constexpr (kApic) {
+            const Vec3 xi = (st.base + Vec3i(i, j, k)).template cast<Real>() * dx - x;
+            mom += w * (mC * xi);  // APIC: m_p (v_p + C_p (x_i - x_p)) (Jiang et al. 2015, eq. (9))
+          }
+          a.px += mom.x();
+          a.py += mom.y();
+          a.pz += mom.z();
+          if constexpr (kFull) {
+            a.m += w * m;
+            const Vec3 f = neg_vs * st.Gradient(i, j, k) + w * fext;
+            a.fx += f.x();
+            a.fy += f.y();
+            a.fz += f.z();
+          }
+        }
+  }
+  for (int a = 0; a < Pad::E; ++a)
+    for (int b = 0; b < Pad::E; ++b)
+      for (int c = 0; c < Pad::Ez; ++c) {
+        const NodeAccum& n = buf[Pad::Index(a, b, c)];
+        if (n.m == 0 && n.px == 0 && n.py == 0 && n.pz == 0 && n.fx == 0 && n.fy == 0 && n.fz == 0)
+          continue;
+        const long g = PaddedToGrid(grid, blk, a, b, c);
+        SURGE_ASSERT(g >= 0);
+        if (g < 0) continue;
+        grid.momentum[g] += Vec3(n.px, n.py, n.pz);
+        if constexpr (kFull) {
+          grid.mass[g] += n.m;
+          grid.force[g] += Vec3(n.fx, n.fy, n.fz);
+        }
+      }
+}
+
+template <int kDim, class K, bool kApic, bool kFull>
+void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& grid) {
+  for (int colour = 0; colour < 8; ++colour) {
+    const auto& blocks = grid.colour[colour];
+    ParallelFor(blocks.size(), 1, [&](size_t i) {
+      thread_local std::vector<NodeAccum> buf;
+      ScatterBlock<kDim, K, kApic, kFull>(ctx, particles, grid, blocks[i], buf);
+    });
+  }
+}
+
+template <bool kFull>
+void ScatterDispatch(const Model& model, const StepContext& ctx, const Particles& particles,
+                     SparseGrid& grid) {
+  const bool apic = model.transfer == TransferScheme::kApic;
+  DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
+    if (apic)
+      Scatter<kDim, K, true, kFull>(ctx, particles, grid);
+    else
+      Scatter<kDim, K, false, kFull>(ctx, particles, grid);
+  });
+}
+
+}  // namespace
+
+void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles& particles,
+                    SparseGrid& grid) {
+  ScatterDispatch<true>(model, ctx, particles, grid);
+}
+
+void RemapMomentum(const Model& model, const StepContext& ctx, const Particles& particles,
+                   SparseGrid& grid) {
+  std::fill(grid.momentum.begin(), grid.momentum.end(), Vec3::Zero());
+  ScatterDispatch<false>(model, ctx, particles, grid);
+  ApplyRemappedVelocity(model, ctx, grid);
+}
+
+}  // namespace surge

@@ -1,0 +1,76 @@
+// Grid topology and particle binning, every step (DESIGN §5; spike note "Design as tested" 1-4).
+#include <algorithm>
+
+#include "core/parallel.h"
+#include "transfer/dispatch.h"
+#include "transfer/transfer.h"
+
+namespace surge {
+namespace {
+
+// Pass 1: owner block and crossing mask of every particle; per-chunk deduplicated requests.
+template <int kDim, class K>
+void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) {
+  const size_t n = particles.size();
+  grid.particle_block_coord.resize(n);
+  grid.chunk_requests.resize(kReductionChunks);
+  ParallelChunks(n, [&](size_t chunk, size_t begin, size_t end) {
+    auto& out = grid.chunk_requests[chunk];
+    out.clear();
+    // Direct-mapped cache of recent (block, mask) entries (spike note: "dedupe quality").
+    constexpr int kCache = 64;
+    BlockRequest cache[kCache];
+    bool used[kCache] = {};
+    BlockRequest last;
+    bool have_last = false;
+    for (size_t p = begin; p < end; ++p) {
+      Vec3i block(0, 0, 0);
+      uint8_t mask = 0;
+      for (int d = 0; d < kDim; ++d) {
+        const int base = K::Base(particles.x[p][d] * inv_dx);
+        block[d] = base >> kBlockBits;  // arithmetic shift = floor division (C++20)
+        const int local = base - (block[d] << kBlockBits);
+        if (local + K::kWidth - 1 >= kBlockDim) mask |= uint8_t(1u << d);
+      }
+      grid.particle_block_coord[p] = block;
+      if (have_last && last.block == block && last.upper == mask) continue;
+      last = BlockRequest{block, mask};
+      have_last = true;
+      const unsigned h = (unsigned(block.x()) * 73856093u ^ unsigned(block.y()) * 19349663u ^
+                          unsigned(block.z()) * 83492791u ^ mask) % kCache;
+      if (used[h] && cache[h].block == block && cache[h].upper == mask) continue;
+      used[h] = true;
+      cache[h] = last;
+      out.push_back(last);
+    }
+  });
+  grid.requests.clear();
+  for (const auto& c : grid.chunk_requests) grid.requests.insert(grid.requests.end(), c.begin(), c.end());
+}
+
+}  // namespace
+
+void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& grid) {
+  const Real inv_dx = 1.0 / model.dx;
+  DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
+    ComputeRequests<kDim, K>(particles, inv_dx, grid);
+  });
+  BuildTopology(grid.requests, grid);
+
+  const size_t n = particles.size();
+  grid.particle_block.resize(n);
+  LookupBlocks(grid, grid.particle_block_coord.data(), n, grid.particle_block.data());
+
+  // Stable counting sort by owner block: order inside a block is particle order, so node sums
+  // are independent of the thread count (spike note, "Determinism").
+  const size_t nb = grid.block_count();
+  grid.block_begin.assign(nb + 1, 0);
+  for (size_t p = 0; p < n; ++p) ++grid.block_begin[grid.particle_block[p] + 1];
+  for (size_t b = 0; b < nb; ++b) grid.block_begin[b + 1] += grid.block_begin[b];
+  grid.sorted.resize(n);
+  std::vector<uint32_t>& cursor = grid.chunk_cursor;
+  cursor.assign(grid.block_begin.begin(), grid.block_begin.end() - 1);
+  for (size_t p = 0; p < n; ++p) grid.sorted[cursor[grid.particle_block[p]]++] = uint32_t(p);
+}
+
+}  // namespace surge

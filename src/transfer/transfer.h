@@ -1,0 +1,61 @@
+// The transfer stages of the explicit MPM cycle (Mast 2013, Fig. 2.1, eqs. (2.12)-(2.22)).
+// Each reads what its comment says and writes only its outputs.
+#pragma once
+#include <array>
+#include <vector>
+
+#include "core/model.h"
+#include "core/particles.h"
+#include "core/step_context.h"
+#include "grid/sparse_grid.h"
+
+namespace surge {
+
+// Activates the blocks under every particle's stencil, numbers them, builds the neighbour and
+// colour tables, bins particles by owner block (stable in particle index) and zeroes the node
+// fields. Reads x. Writes grid topology, binning and node arrays.
+void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& grid);
+
+// P2G (2.12): lumped mass, momentum (with the APIC affine term when selected), internal force
+// -sum V_p sigma_p grad N_ip and particle traction forces. Race-free and deterministic: blocks
+// of one colour never share nodes; every node sum has a fixed order for any thread count.
+void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles& particles,
+                    SparseGrid& grid);
+
+// Per-face wall results of one grid update.
+struct WallReport {
+  std::array<Vec3, 6> force{};  // reaction force on each wall (on the wall, from the material) [N]
+  Real work = 0;                // work of all walls on the material during this step [J]
+};
+
+// Grid solve (2.13)-(2.14) and domain walls (seed Planar / Fixed nodes, spec §5.3): v_n = p/m,
+// v_{n+1} = v_n + dt (f/m + g), then the wall constraints on v_{n+1}. Nodes with no mass get
+// zero velocity. Reads mass, momentum, force. Writes velocity, velocity_new, report.
+void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
+                        WallReport& report);
+
+// G2P (2.22) with the selected transfer (FLIP increment, PIC/FLIP blend, APIC) and the position
+// update x += dt sum N v_{n+1}. When velocity_gradient is non-null it also writes
+// MUSL helper: v_{n+1} = p/m from the re-mapped momentum, walls re-applied (no reaction logged).
+void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid);
+
+// L_p = sum v_{i,n+1} (x) grad N_ip (2.17) (USL). When x_new is non-null, new positions go
+// there instead of particles.x (MUSL, which still needs x_n for the re-mapped gradient).
+void GridToParticle(const Model& model, const StepContext& ctx, const SparseGrid& grid,
+                    Particles& particles, std::vector<Mat3>* velocity_gradient,
+                    std::vector<Vec3>* x_new);
+
+// MUSL (Sulsky et al. 1995): re-map the updated particle momentum to the grid with the shape
+// functions of x_n, recompute v_{n+1} = p/m and re-apply the walls (no reaction logged).
+// Reads particles v, C, x; writes grid.momentum and grid.velocity_new.
+void RemapMomentum(const Model& model, const StepContext& ctx, const Particles& particles,
+                   SparseGrid& grid);
+
+// MUSL helper: v_{n+1} = p/m from the re-mapped momentum, walls re-applied (no reaction logged).
+void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid);
+
+// L_p = sum v_{i,n+1} (x) grad N_ip from grid.velocity_new (2.17). Writes velocity_gradient.
+void ComputeVelocityGradient(const Model& model, const StepContext& ctx, const SparseGrid& grid,
+                             const Particles& particles, std::vector<Mat3>& velocity_gradient);
+
+}  // namespace surge
