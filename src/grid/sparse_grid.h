@@ -55,6 +55,7 @@ struct SparseGrid {
   std::vector<std::vector<BlockRequest>> chunk_requests;
   std::vector<BlockRequest> requests;
   std::vector<uint32_t> chunk_cursor;
+  std::vector<std::array<Real, 19>> wall_partials;  // per-block wall reactions (grid_update.cpp)
 
   std::unique_ptr<BlockTopology> topology;
 

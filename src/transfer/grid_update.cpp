@@ -74,7 +74,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
   const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, robust to round-off of i*dx
   const size_t nb = grid.block_count();
   // Per-block partial reactions, summed in block order afterwards (deterministic).
-  thread_local std::vector<std::array<Real, 19>> partial;  // 6 faces x 3 + work
+  std::vector<std::array<Real, 19>>& partial = grid.wall_partials;  // 6 faces x 3 + work
   partial.assign(nb, {});
   ParallelFor(nb, 4, [&](size_t b) {
     auto& part = partial[b];
@@ -97,7 +97,9 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
           // Reaction on each wall: R = -m dv / dt (spec §5.3).
           for (int k = 0; k < wall_count; ++k)
             for (int d = 0; d < 3; ++d) part[3 * walls[k].face + d] -= m * dv[k][d] / ctx.dt;
-          part[18] += 0.5 * m * (vc.squaredNorm() - vu.squaredNorm());
+          // Work of the wall force on the material at the constrained velocity: zero for
+          // fixed and frictionless walls, negative for sliding friction.
+          part[18] += m * (vc - vu).dot(vc);
         }
       }
       grid.velocity_new[i] = vc;
