@@ -4,7 +4,9 @@
 #include "scene/scene_builder.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "mesh/mesh.h"
@@ -39,10 +41,17 @@ std::string BodyPath(size_t b) { return "bodies[" + std::to_string(b) + "]"; }
   throw SceneError(loc.source, loc.line, loc.column, path, msg);
 }
 
+// Shortest decimal text that reads back to the same double.
+std::string Num(Real v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, r.ptr);
+}
+
 std::string Point(const Vec3& x, int dim) {
   std::string s = "(";
-  for (int a = 0; a < dim; ++a) s += (a ? ", " : "") + std::to_string(x[a]);
-  return s + ")";
+  for (int a = 0; a < dim; ++a) s.append(a ? ", " : "").append(Num(x[a]));
+  return s.append(")");
 }
 
 // Particles of one body, in seeding order.
@@ -85,7 +94,7 @@ SeededBody SeedBody(const SceneSpec& spec, size_t b) {
   if (candidates > kMaxCandidates) {
     Fail(body.region_loc, path + ".region",
          "the region spans about " + std::to_string(static_cast<long long>(candidates)) +
-             " particle lattice points at spacing " + std::to_string(s) +
+             " particle lattice points at spacing " + Num(s) +
              " m (limit 4e8); use a larger cell_size or fewer particles_per_cell");
   }
 
@@ -93,7 +102,7 @@ SeededBody SeedBody(const SceneSpec& spec, size_t b) {
   out.x = SampleRegion(body.region, dim, s, mesh_ptr);
   if (out.x.empty()) {
     Fail(body.region_loc, path + ".region",
-         "the region contains no particles at spacing " + std::to_string(s) +
+         "the region contains no particles at spacing " + Num(s) +
              " m (cell_size / particles_per_cell); it may be thinner than one spacing");
   }
   JitterPositions(dim, s, body.jitter, body.seed, out.x);

@@ -512,7 +512,10 @@ RegionShape Parser::ParseRegion(const YAML::Node& n, const std::string& path) co
   MeshRegion mesh;
   const YAML::Node file = Need(s, p, "file");
   const std::filesystem::path f = String(file, Child(p, "file"));
-  mesh.file = (f.is_absolute() ? f : std::filesystem::path(base_dir_) / f).lexically_normal().string();
+  // Absolute, so that the resolved YAML (kept with the results) reads back from anywhere.
+  mesh.file = std::filesystem::absolute(f.is_absolute() ? f : std::filesystem::path(base_dir_) / f)
+                  .lexically_normal()
+                  .string();
   mesh.file_loc = Loc(file, Child(p, "file"));
   if (s["scale"]) mesh.scale = Positive(s["scale"], Child(p, "scale"), "-");
   if (s["translate"]) mesh.translate = Vector(s["translate"], Child(p, "translate"), "m");
@@ -734,7 +737,7 @@ void EmitWall(YAML::Emitter& e, const Wall& w) {
 }
 
 void EmitRegion(YAML::Emitter& e, const RegionShape& region, int dim) {
-  e << YAML::BeginMap;
+  e << YAML::Flow << YAML::BeginMap;
   if (const auto* box = std::get_if<BoxRegion>(&region)) {
     e << YAML::Key << "box" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "min" << YAML::Value;
@@ -875,7 +878,9 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
         << YAML::Key << "geostatic" << YAML::Value << YAML::BeginMap << YAML::Key << "k0"
         << YAML::Value << Num(*b.geostatic_k0) << YAML::EndMap << YAML::EndMap;
     }
-    e << YAML::Key << "tractions" << YAML::Value << YAML::BeginSeq;
+    e << YAML::Key << "tractions" << YAML::Value;
+    if (b.tractions.empty()) e << YAML::Flow;
+    e << YAML::BeginSeq;
     for (const TractionSpec& t : b.tractions) {
       e << YAML::Flow << YAML::BeginMap << YAML::Key << "face" << YAML::Value << FaceName(t.face)
         << YAML::Key << "traction" << YAML::Value;

@@ -1,0 +1,445 @@
+// Scene parser: every malformed scene gives a SceneError naming the key path and the line;
+// --set overrides; resolved YAML reads back to the same model.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace surge {
+namespace {
+
+// A valid 3-D scene; tests edit single lines so the line numbers below stay valid.
+//  1 name            5 domain          9 "- name: block"
+//  2 dimension       6 materials:     10 material
+//  3 time            7 steel          11 region
+//  4 grid            8 bodies:        12 (first appended line)
+const std::string kBase3 =
+    "name: t\n"
+    "dimension: 3\n"
+    "time: {end: 1.0}\n"
+    "grid: {cell_size: 0.25}\n"
+    "domain: {min: [-1, -1, -1], max: [2, 2, 2]}\n"
+    "materials:\n"
+    "  steel: {model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3}\n"
+    "bodies:\n"
+    "  - name: block\n"
+    "    material: steel\n"
+    "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n";
+
+const std::string kBase2 =
+    "name: t2\n"
+    "dimension: 2\n"
+    "time: {end: 1.0}\n"
+    "grid: {cell_size: 0.25}\n"
+    "domain: {min: [-1, -1], max: [2, 2]}\n"
+    "materials:\n"
+    "  steel: {model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3}\n"
+    "bodies:\n"
+    "  - name: block\n"
+    "    material: steel\n"
+    "    region: {box: {min: [0, 0], max: [1, 1]}}\n";
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << "fixture text not found: " << from;
+  if (pos != std::string::npos) text.replace(pos, from.size(), to);
+  return text;
+}
+
+struct Caught {
+  bool thrown = false;
+  std::string what;
+  std::string file;
+  int line = 0;
+  std::string key_path;
+};
+
+Caught Load(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  Caught c;
+  try {
+    LoadSceneFromString(text, "bad.yaml", overrides);
+  } catch (const SceneError& e) {
+    c = {true, e.what(), e.file(), e.line(), e.key_path()};
+  }
+  return c;
+}
+
+// The error names the key path and the line ("bad.yaml:<line>:"), and says `fragment`.
+void ExpectError(const std::string& text, int line, const std::string& key_path,
+                 const std::string& fragment) {
+  const Caught c = Load(text);
+  ASSERT_TRUE(c.thrown) << "no SceneError for:\n" << text;
+  EXPECT_EQ(c.line, line) << c.what;
+  EXPECT_EQ(c.key_path, key_path) << c.what;
+  EXPECT_NE(c.what.find("bad.yaml:" + std::to_string(line) + ":"), std::string::npos) << c.what;
+  EXPECT_NE(c.what.find(key_path + ": "), std::string::npos) << c.what;
+  EXPECT_NE(c.what.find(fragment), std::string::npos) << c.what;
+}
+
+TEST(SceneParserTest, BaseScenesAreValid) {
+  EXPECT_FALSE(Load(kBase3).thrown) << Load(kBase3).what;
+  EXPECT_FALSE(Load(kBase2).thrown) << Load(kBase2).what;
+}
+
+TEST(SceneParserTest, UnknownTopLevelKey) {
+  ExpectError(kBase3 + "gravty: [0, -9.81, 0]\n", 12, "gravty",
+              "unknown key 'gravty' (expected one of: name, dimension, time, gravity");
+}
+
+TEST(SceneParserTest, UnknownNestedKey) {
+  ExpectError(kBase3 + "    veloctiy: [1, 0, 0]\n", 12, "bodies[0].veloctiy",
+              "unknown key 'veloctiy' (expected one of: name, material, region,");
+}
+
+TEST(SceneParserTest, MissingRequiredKeyReportsTheParentMap) {
+  ExpectError(Replace(kBase3, "    material: steel\n", ""), 9, "bodies[0].material",
+              "missing required key 'material'");
+  ExpectError(Replace(kBase3, "time: {end: 1.0}", "time: {cfl: 0.5}"), 3, "time.end",
+              "missing required key 'end'");
+}
+
+TEST(SceneParserTest, StringWhereNumberExpected) {
+  ExpectError(Replace(kBase3, "cell_size: 0.25", "cell_size: big"), 4, "grid.cell_size",
+              "expected a number [m], got \"big\"");
+}
+
+TEST(SceneParserTest, StringWhereVectorExpected) {
+  const Caught c = Load(kBase3 + "    velocity: fast\n");
+  ASSERT_TRUE(c.thrown);
+  EXPECT_EQ(c.what,
+            "bad.yaml:12:15: bodies[0].velocity: expected a list of 3 numbers [m/s], got \"fast\"");
+}
+
+TEST(SceneParserTest, VectorOfWrongLength) {
+  ExpectError(Replace(kBase3, "min: [-1, -1, -1]", "min: [-1, -1]"), 5, "domain.min",
+              "expected a list of 3 numbers [m], got a list of 2 items");
+  ExpectError(Replace(kBase2, "min: [-1, -1]", "min: [-1, -1, 0, 0]"), 5, "domain.min",
+              "expected a list of 2 numbers (or 3 with z = 0) [m]");
+}
+
+TEST(SceneParserTest, NonZeroZIn2D) {
+  ExpectError(kBase2 + "    velocity: [1, 0, 3]\n", 12, "bodies[0].velocity",
+              "in 2-D the z component must be 0");
+}
+
+TEST(SceneParserTest, NegativeCellSize) {
+  ExpectError(Replace(kBase3, "cell_size: 0.25", "cell_size: -0.25"), 4, "grid.cell_size",
+              "must be > 0 [m], got -0.25");
+}
+
+TEST(SceneParserTest, CflAboveOne) {
+  ExpectError(Replace(kBase3, "time: {end: 1.0}", "time: {end: 1.0, cfl: 1.5}"), 3, "time.cfl",
+              "must be in (0, 1] [-], got 1.5");
+}
+
+TEST(SceneParserTest, UnknownShapeFunction) {
+  ExpectError(Replace(kBase3, "{cell_size: 0.25}", "{cell_size: 0.25, shape_function: quadratic}"),
+              4, "grid.shape_function",
+              "unknown value 'quadratic' (expected one of: linear, gimp, quadratic_bspline, "
+              "cubic_bspline)");
+}
+
+TEST(SceneParserTest, FlipRatioWithoutPicFlip) {
+  ExpectError(Replace(kBase3, "{cell_size: 0.25}", "{cell_size: 0.25, flip_ratio: 0.9}"), 4,
+              "grid.flip_ratio", "only to transfer: pic_flip");
+}
+
+TEST(SceneParserTest, UnknownWallType) {
+  ExpectError(Replace(kBase3, "max: [2, 2, 2]}", "max: [2, 2, 2], walls: {x-: sticky}}"), 5,
+              "domain.walls.x-", "unknown value 'sticky' (expected one of: open, slip, no_slip)");
+  ExpectError(Replace(kBase3, "max: [2, 2, 2]}", "max: [2, 2, 2], walls: {x-: {type: glue}}}"),
+              5, "domain.walls.x-.type", "unknown value 'glue'");
+}
+
+TEST(SceneParserTest, ZWallIn2D) {
+  ExpectError(Replace(kBase2, "max: [2, 2]}", "max: [2, 2], walls: {z-: slip}}"), 5,
+              "domain.walls.z-", "not allowed in 2-D");
+}
+
+TEST(SceneParserTest, NegativeFriction) {
+  ExpectError(Replace(kBase3, "max: [2, 2, 2]}", "max: [2, 2, 2], walls: {y-: {friction: -0.3}}}"),
+              5, "domain.walls.y-.friction", "must be >= 0 [-], got -0.3");
+}
+
+TEST(SceneParserTest, BodyReferencesUnknownMaterial) {
+  ExpectError(Replace(kBase3, "material: steel", "material: stee"), 10, "bodies[0].material",
+              "unknown material 'stee' (defined: steel)");
+}
+
+TEST(SceneParserTest, BothElasticPairs) {
+  ExpectError(Replace(kBase3, "poisson_ratio: 0.3}", "poisson_ratio: 0.3, bulk_modulus: 1e9}"), 7,
+              "materials.steel", "not both");
+}
+
+TEST(SceneParserTest, MissingElasticConstants) {
+  ExpectError(Replace(kBase3, ", youngs_modulus: 2.0e11, poisson_ratio: 0.3", ""), 7,
+              "materials.steel", "missing elastic constants");
+  ExpectError(Replace(kBase3, ", poisson_ratio: 0.3", ""), 7, "materials.steel.poisson_ratio",
+              "missing required key 'poisson_ratio'");
+}
+
+TEST(SceneParserTest, PoissonRatioOneHalf) {
+  ExpectError(Replace(kBase3, "poisson_ratio: 0.3", "poisson_ratio: 0.5"), 7,
+              "materials.steel.poisson_ratio", "must be in (-1, 0.5) [-], got 0.5");
+}
+
+TEST(SceneParserTest, UnknownMaterialModel) {
+  ExpectError(Replace(kBase3, "model: linear_elastic", "model: linear_elastic_2d"), 7,
+              "materials.steel.model", "expected one of: linear_elastic, neo_hookean");
+}
+
+TEST(SceneParserTest, DuplicateBodyName) {
+  ExpectError(kBase3 +
+                  "  - name: block\n"
+                  "    material: steel\n"
+                  "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n",
+              12, "bodies[1].name", "duplicate body name 'block' (also bodies[0])");
+}
+
+TEST(SceneParserTest, DuplicateKey) {
+  ExpectError(kBase3 + "    material: steel\n", 12, "bodies[0].material", "duplicate key");
+}
+
+TEST(SceneParserTest, EmptyBodies) {
+  const std::string text = kBase3.substr(0, kBase3.find("bodies:")) + "bodies: []\n";
+  ExpectError(text, 8, "bodies", "expected a non-empty list of bodies");
+}
+
+TEST(SceneParserTest, YamlSyntaxErrorReportsItsLine) {
+  const Caught c = Load(Replace(kBase3, "  - name: block\n", "  - name: block\n   bad: [1, 2\n"));
+  ASSERT_TRUE(c.thrown);
+  EXPECT_GE(c.line, 10) << c.what;
+  EXPECT_LE(c.line, 12) << c.what;
+  EXPECT_NE(c.what.find("YAML syntax error"), std::string::npos) << c.what;
+}
+
+TEST(SceneParserTest, SyntaxErrorFileReportsItsLine) {
+  const std::string path = std::string(SURGE_SOURCE_DIR) + "/tests/data/bad_scenes/syntax_error.yaml";
+  try {
+    LoadScene(path);
+    FAIL() << "expected SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_GE(e.line(), 6) << e.what();
+    EXPECT_LE(e.line(), 7) << e.what();
+  }
+}
+
+TEST(SceneParserTest, UnknownKeyInFileNamesFileAndLine) {
+  const std::string path = std::string(SURGE_SOURCE_DIR) + "/tests/data/bad_scenes/unknown_key.yaml";
+  try {
+    LoadScene(path);
+    FAIL() << "expected SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.line(), 11);
+    EXPECT_EQ(e.key_path(), "bodies[0].veloctiy");
+    EXPECT_NE(std::string(e.what()).find("unknown_key.yaml:11:5: bodies[0].veloctiy: unknown key"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(SceneParserTest, UnreadableFile) {
+  try {
+    LoadScene("/nonexistent/dir/scene.yaml");
+    FAIL() << "expected SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.file(), "/nonexistent/dir/scene.yaml");
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/scene.yaml: cannot read scene file"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(SceneParserTest, MissingMeshFile) {
+  const std::string path = std::string(SURGE_SOURCE_DIR) + "/tests/data/bad_scenes/missing_mesh.yaml";
+  try {
+    LoadScene(path);
+    FAIL() << "expected SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.line(), 12) << e.what();
+    EXPECT_EQ(e.key_path(), "bodies[0].region.mesh.file") << e.what();
+    EXPECT_NE(std::string(e.what()).find("no_such_mesh.stl"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneParserTest, OpenMeshIsRefused) {
+  const std::string path = std::string(SURGE_SOURCE_DIR) + "/tests/data/bad_scenes/open_mesh.yaml";
+  try {
+    LoadScene(path);
+    FAIL() << "expected SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.line(), 12) << e.what();
+    EXPECT_EQ(e.key_path(), "bodies[0].region.mesh.file") << e.what();
+    EXPECT_NE(std::string(e.what()).find("not closed"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneParserTest, BodyOutsideDomain) {
+  ExpectError(Replace(kBase3, "max: [1, 1, 1]}}", "max: [3, 1, 1]}}"), 11, "bodies[0].region",
+              "outside the domain");
+}
+
+TEST(SceneParserTest, RegionWithoutParticles) {
+  ExpectError(Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}",
+                      "{sphere: {center: [0, 0, 0], radius: 0.01}}"),
+              11, "bodies[0].region", "contains no particles");
+}
+
+TEST(SceneParserTest, RegionWithTwoShapes) {
+  ExpectError(Replace(kBase3, "max: [1, 1, 1]}}", "max: [1, 1, 1]}, sphere: {center: [0, 0, 0], radius: 1}}"),
+              11, "bodies[0].region", "expected exactly one of: box, sphere, cylinder, polygon, mesh");
+}
+
+TEST(SceneParserTest, GeostaticWithoutGravity) {
+  ExpectError(kBase3 + "    initial_stress: {geostatic: {k0: 0.5}}\n", 12,
+              "bodies[0].initial_stress.geostatic", "needs a non-zero gravity");
+}
+
+TEST(SceneParserTest, GeostaticOnNeoHookean) {
+  const std::string text = Replace(kBase3, "model: linear_elastic", "model: neo_hookean") +
+                           "    initial_stress: {geostatic: {k0: 0.5}}\n" + "gravity: [0, -10, 0]\n";
+  ExpectError(text, 12, "bodies[0].initial_stress.geostatic", "neo_hookean");
+}
+
+TEST(SceneParserTest, JitterOutOfRange) {
+  ExpectError(kBase3 + "    jitter: 1.0\n", 12, "bodies[0].jitter", "must be in [0, 1) [-], got 1.0");
+}
+
+TEST(SceneParserTest, ParticlesPerCellNotAnInteger) {
+  ExpectError(kBase3 + "    particles_per_cell: 2.5\n", 12, "bodies[0].particles_per_cell",
+              "expected an integer");
+  ExpectError(kBase3 + "    particles_per_cell: 9\n", 12, "bodies[0].particles_per_cell",
+              "must be an integer in [1, 8]");
+}
+
+TEST(SceneParserTest, BadDimensionAndName) {
+  ExpectError(Replace(kBase3, "dimension: 3", "dimension: 4"), 2, "dimension",
+              "must be an integer in [2, 3]");
+  ExpectError(Replace(kBase3, "name: t\n", "name: my scene\n"), 1, "name",
+              "may contain only letters");
+}
+
+TEST(SceneParserTest, CylinderAndMeshAre3DOnly) {
+  ExpectError(Replace(kBase2, "{box: {min: [0, 0], max: [1, 1]}}",
+                      "{cylinder: {base: [0, 0], top: [0, 1], radius: 0.2}}"),
+              11, "bodies[0].region.cylinder", "3-D only");
+}
+
+TEST(SceneParserTest, SelfIntersectingPolygon) {
+  ExpectError(Replace(kBase2, "{box: {min: [0, 0], max: [1, 1]}}",
+                      "{polygon: {points: [[0, 0], [1, 1], [1, 0], [0, 1]]}}"),
+              11, "bodies[0].region.polygon.points", "must be simple");
+}
+
+TEST(SceneParserTest, PolygonZIn2D) {
+  ExpectError(Replace(kBase2, "{box: {min: [0, 0], max: [1, 1]}}",
+                      "{polygon: {points: [[0, 0], [1, 0], [0, 1]], z: [0, 1]}}"),
+              11, "bodies[0].region.polygon.z", "not allowed in 2-D");
+}
+
+TEST(SceneParserTest, TractionOnZFaceIn2D) {
+  ExpectError(kBase2 + "    tractions: [{face: z+, traction: [0, 1]}]\n", 12,
+              "bodies[0].tractions[0].face", "expected one of: x-, x+, y-, y+");
+}
+
+TEST(SceneParserTest, EmptyScene) {
+  const Caught c = Load("");
+  ASSERT_TRUE(c.thrown);
+  EXPECT_NE(c.what.find("the scene is empty"), std::string::npos) << c.what;
+}
+
+// --- --set overrides --------------------------------------------------------------------------
+
+TEST(SceneOverrideTest, ListIndexOutOfRange) {
+  const Caught c = Load(kBase3, {"bodies.3.velocity=[1,0,0]"});
+  ASSERT_TRUE(c.thrown);
+  EXPECT_EQ(c.file, "--set bodies.3.velocity=[1,0,0]");
+  EXPECT_EQ(c.key_path, "bodies[3]");
+  EXPECT_NE(c.what.find("out of range (the list has 1 items)"), std::string::npos) << c.what;
+}
+
+TEST(SceneOverrideTest, CreatedUnknownKeyIsCaught) {
+  const Caught c = Load(kBase3, {"bodies.0.veloctiy=[1,0,0]"});
+  ASSERT_TRUE(c.thrown);
+  EXPECT_EQ(c.what.rfind("--set bodies.0.veloctiy=[1,0,0]: bodies[0].veloctiy: unknown key", 0), 0u)
+      << c.what;
+}
+
+TEST(SceneOverrideTest, BadValueNamesTheOverride) {
+  const Caught c = Load(kBase3, {"time.end=-1"});
+  ASSERT_TRUE(c.thrown);
+  EXPECT_EQ(c.what, "--set time.end=-1: time.end: must be > 0 [s], got -1");
+}
+
+TEST(SceneOverrideTest, MissingKeyUnderCreatedMapNamesTheOverride) {
+  const Caught c = Load(kBase3, {"bodies.0.initial_stress.geostatic.kzero=1"});
+  ASSERT_TRUE(c.thrown);
+  EXPECT_EQ(c.file, "--set bodies.0.initial_stress.geostatic.kzero=1") << c.what;
+}
+
+TEST(SceneOverrideTest, MalformedOverride) {
+  EXPECT_TRUE(Load(kBase3, {"time.end"}).thrown);
+  EXPECT_TRUE(Load(kBase3, {"time..end=1"}).thrown);
+  EXPECT_TRUE(Load(kBase3, {"time.end.x=1"}).thrown);
+  EXPECT_TRUE(Load(kBase3, {"bodies.x.name=a"}).thrown);
+}
+
+TEST(SceneOverrideTest, SetsValuesBeforeValidation) {
+  const LoadedScene s = LoadSceneFromString(
+      kBase3, "s.yaml",
+      {"bodies.0.velocity=[2,0,0]", "time.end=0.5", "grid.transfer=pic_flip",
+       "grid.flip_ratio=0.9", "gravity=[0,-10,0]", "domain.walls.y-={friction: 0.4}"});
+  EXPECT_EQ(s.model.time.end, 0.5);
+  EXPECT_EQ(s.model.transfer, TransferScheme::kPicFlip);
+  EXPECT_EQ(s.model.flip_ratio, 0.9);
+  EXPECT_EQ(s.model.gravity, Vec3(0, -10, 0));
+  EXPECT_EQ(s.model.walls[static_cast<int>(Face::kYMin)].kind, WallKind::kFriction);
+  EXPECT_EQ(s.model.walls[static_cast<int>(Face::kYMin)].friction, 0.4);
+  for (const Vec3& v : s.state.particles.v) EXPECT_EQ(v, Vec3(2, 0, 0));
+  EXPECT_EQ(s.text, kBase3);  // the echo is the file, not the overridden tree
+}
+
+// --- resolved YAML ----------------------------------------------------------------------------
+
+TEST(SceneResolvedYamlTest, FillsDefaults) {
+  const LoadedScene s = LoadSceneFromString(kBase3, "s.yaml");
+  for (const char* key : {"cfl: 0.4", "min_dt: 1e-12", "max_dt: 1e+30", "shape_function: quadratic_bspline",
+                          "transfer: apic", "update: usl", "on_exit: remove", "x-: open",
+                          "particles_per_cell: 2", "jitter: 0", "seed: 1", "every: 0", "energy: true"}) {
+    EXPECT_NE(s.resolved_yaml.find(key), std::string::npos) << key << " in\n" << s.resolved_yaml;
+  }
+}
+
+TEST(SceneResolvedYamlTest, RereadsToTheSameScene) {
+  const std::string path = std::string(SURGE_SOURCE_DIR) + "/tests/data/scenes/full_3d.yaml";
+  const LoadedScene a = LoadScene(path);
+  const LoadedScene b = LoadSceneFromString(a.resolved_yaml, "resolved.yaml");
+  EXPECT_EQ(b.resolved_yaml, a.resolved_yaml);
+  EXPECT_EQ(a.state.particles.x, b.state.particles.x);
+  EXPECT_EQ(a.state.particles.stress, b.state.particles.stress);
+  EXPECT_EQ(a.state.particles.ext_force, b.state.particles.ext_force);
+  EXPECT_EQ(a.model.dx, b.model.dx);
+  EXPECT_EQ(a.model.flip_ratio, b.model.flip_ratio);
+  ASSERT_EQ(a.model.materials.size(), b.model.materials.size());
+  for (size_t m = 0; m < a.model.materials.size(); ++m) {
+    EXPECT_EQ(WaveSpeed(a.model.materials[m]), WaveSpeed(b.model.materials[m]));
+  }
+  for (int f = 0; f < kFaceCount; ++f) {
+    EXPECT_EQ(a.model.walls[f].kind, b.model.walls[f].kind);
+    EXPECT_EQ(a.model.walls[f].friction, b.model.walls[f].friction);
+    EXPECT_EQ(a.model.walls[f].separable, b.model.walls[f].separable);
+  }
+}
+
+TEST(SceneResolvedYamlTest, RereadsIn2D) {
+  const LoadedScene a = LoadSceneFromString(kBase2 + "    tractions: [{face: x+, traction: [5, 0]}]\n", "s.yaml");
+  const LoadedScene b = LoadSceneFromString(a.resolved_yaml, "resolved.yaml");
+  EXPECT_EQ(b.resolved_yaml, a.resolved_yaml);
+  EXPECT_EQ(a.state.particles.ext_force, b.state.particles.ext_force);
+}
+
+}  // namespace
+}  // namespace surge
