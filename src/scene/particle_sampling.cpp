@@ -80,11 +80,13 @@ void LatticeRange(Real a, Real b, Real s, int64_t& lo, int64_t& hi) {
 }  // namespace
 
 double CountLatticePoints(const Aabb& bounds, int dim, Real spacing) {
+  // In doubles, without the integer casts of LatticeRange: coordinates far beyond the int64
+  // lattice range (or non-finite) give infinity, which the caller refuses.
   double count = 1;
   for (int a = 0; a < dim; ++a) {
-    int64_t lo, hi;
-    LatticeRange(bounds.min[a], bounds.max[a], spacing, lo, hi);
-    count *= static_cast<double>(hi - lo + 1);
+    const double lo = bounds.min[a] / spacing, hi = bounds.max[a] / spacing;
+    if (!(std::abs(lo) < 1e15 && std::abs(hi) < 1e15)) return HUGE_VAL;
+    count *= std::floor(hi - lo) + 5;  // points in [lo, hi] plus the guard indices
   }
   return count;
 }

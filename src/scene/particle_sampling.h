@@ -17,8 +17,9 @@ Aabb RegionBounds(const RegionShape& region, const TriangleMesh* mesh);
 // Is `x` inside the region? In 2-D (dim == 2) only x and y are tested.
 bool InsideRegion(const RegionShape& region, int dim, const TriangleMesh* mesh, const Vec3& x);
 
-// Number of lattice points x = (i + 1/2) s in `bounds` (per seeded axis), as a double so that
-// absurd requests can be refused before any allocation.
+// Upper bound on the lattice points x = (i + 1/2) s that SampleRegion scans in `bounds`, as a
+// double so that absurd requests can be refused before any allocation; infinity when the
+// coordinates are too large for the lattice index range.
 double CountLatticePoints(const Aabb& bounds, int dim, Real spacing);
 
 // Lattice points x = (i + 1/2) s (z = 0 in 2-D) inside the region, x fastest, then y, then z.

@@ -93,7 +93,7 @@ SeededBody SeedBody(const SceneSpec& spec, size_t b) {
   const double candidates = CountLatticePoints(RegionBounds(body.region, mesh_ptr), dim, s);
   if (candidates > kMaxCandidates) {
     Fail(body.region_loc, path + ".region",
-         "the region spans about " + std::to_string(static_cast<long long>(candidates)) +
+         "the region spans about " + Num(std::round(candidates)) +
              " particle lattice points at spacing " + Num(s) +
              " m (limit 4e8); use a larger cell_size or fewer particles_per_cell");
   }

@@ -345,6 +345,55 @@ TEST(SceneParserTest, TractionOnZFaceIn2D) {
               "bodies[0].tractions[0].face", "expected one of: x-, x+, y-, y+");
 }
 
+TEST(SceneParserTest, HugeRegionIsRefusedBeforeSeeding) {
+  ExpectError(Replace(kBase3, "max: [1, 1, 1]}}", "max: [1.0e30, 1, 1]}}"), 11, "bodies[0].region",
+              "particle lattice points");
+  ExpectError(Replace(kBase3, "cell_size: 0.25", "cell_size: 1.0e-7"), 11, "bodies[0].region",
+              "limit 4e8");
+}
+
+// Odd inputs: each must give a SceneError (never a crash or another exception type).
+TEST(SceneParserTest, OddInputsGiveSceneErrors) {
+  const std::vector<std::string> texts = {
+      "hello",
+      "[1, 2, 3]",
+      "name: [a]\n",
+      "? [a, b]\n: 1\n",
+      Replace(kBase3, "materials:\n", "materials:\n  ? [x]\n  : {}\n"),
+      Replace(kBase3, "  - name: block\n", "  - ~\n  - name: block\n"),
+      Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}", "{box: ~}"),
+      Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}", "{}"),
+      Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}", "[box]"),
+      Replace(kBase3, "min: [0, 0, 0]", "min: [0, .nan, 0]"),
+      Replace(kBase3, "min: [0, 0, 0]", "min: [0, .inf, 0]"),
+      Replace(kBase3, "min: [0, 0, 0]", "min: [0, [0], 0]"),
+      Replace(kBase3, "dimension: 3", "dimension: 99999999999999999999999"),
+      Replace(kBase3, "time: {end: 1.0}", "time: &t {end: 1.0}\nalias: *t"),
+      kBase3 + "    seed: -1\n",
+      kBase3 + "    tractions: {face: x+}\n",
+      kBase3 + "    tractions: [{face: x+}]\n",
+      kBase3 + "    initial_stress: {hydrostatic: {}}\n",
+      Replace(kBase3, "max: [2, 2, 2]}", "max: [2, 2, 2], walls: {x-: {type: friction}}}"),
+      Replace(kBase3, "max: [2, 2, 2]}", "max: [2, 2, 2], walls: {x-: {type: no_slip, separable: false}}}"),
+      Replace(kBase3, "max: [2, 2, 2]}", "max: [2, 2, 2], walls: [slip]}"),
+      Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}",
+              "{polygon: {points: [[0, 0], [1, 0], [2, 0]], z: [0, 1]}}"),
+      Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}",
+              "{polygon: {points: [[0, 0], [1, 0], [0, 1]], z: [1, 0]}}"),
+      Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}",
+              "{mesh: {file: " + std::string(SURGE_SOURCE_DIR) + "/tests/data/meshes/not_a_mesh.obj}}"),
+      Replace(kBase3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}", "{mesh: {file: /}}"),
+  };
+  for (const std::string& text : texts) {
+    try {
+      LoadSceneFromString(text, "odd.yaml");
+      ADD_FAILURE() << "accepted:\n" << text;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("odd.yaml"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(SceneParserTest, EmptyScene) {
   const Caught c = Load("");
   ASSERT_TRUE(c.thrown);
