@@ -9,8 +9,8 @@ namespace surge {
 namespace {
 
 struct NodeVel {
-  Vec3 v0;  // v_{i,n}
-  Vec3 v1;  // v_{i,n+1}
+  Real v0[3];  // v_{i,n}
+  Real v1[3];  // v_{i,n+1}
 };
 
 template <int kDim, class K>
@@ -22,12 +22,9 @@ void GatherHalo(const SparseGrid& grid, size_t blk, std::vector<NodeVel>& halo) 
       for (int c = 0; c < Pad::Ez; ++c) {
         const long g = PaddedToGrid(grid, blk, a, b, c);
         NodeVel& n = halo[Pad::Index(a, b, c)];
-        if (g < 0) {
-          n.v0.setZero();
-          n.v1.setZero();
-        } else {
-          n.v0 = grid.velocity[g];
-          n.v1 = grid.velocity_new[g];
+        for (int d = 0; d < 3; ++d) {
+          n.v0[d] = g < 0 ? 0.0 : grid.velocity[g][d];
+          n.v1[d] = g < 0 ? 0.0 : grid.velocity_new[g][d];
         }
       }
 }
@@ -49,24 +46,46 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
       Stencil<kDim, K> st;
       st.Compute(x, ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
       const Vec3i lb = st.base - origin;
-      Vec3 v_pic = Vec3::Zero();  // sum N v_{n+1}
-      Vec3 dv = Vec3::Zero();     // sum N (v_{n+1} - v_n)
-      Mat3 L = Mat3::Zero();      // sum v_{n+1} (x) grad N
-      Mat3 B = Mat3::Zero();      // sum N v_{n+1} (x) (x_i - x_p)
+      Real vpic[3] = {0, 0, 0};  // sum N v_{n+1}
+      Real dv[3] = {0, 0, 0};    // sum N (v_{n+1} - v_n)
+      Real l[3][3] = {};         // sum v_{n+1} (x) grad N
+      Real bm[3][3] = {};        // sum N v_{n+1} (x) (x_i - x_p)
+      Real off[3][Stencil<kDim, K>::W];
+      for (int d = 0; d < 3; ++d)
+        for (int k = 0; k < (d < kDim ? st.W : 1); ++k) off[d][k] = (st.base[d] + k) * ctx.dx - x[d];
+      constexpr bool kNeedB = kMode == G2PMode::kApic && !kApicUsesGradient<K>;
+      const bool need_l = velocity_gradient || (kMode == G2PMode::kApic && kApicUsesGradient<K>);
       for (int i = 0; i < st.W; ++i)
-        for (int j = 0; j < st.W; ++j)
+        for (int j = 0; j < st.W; ++j) {
+          const Real wxy = st.w[0][i] * st.w[1][j];
+          const Real gxy_x = st.g[0][i] * st.w[1][j];
+          const Real gxy_y = st.w[0][i] * st.g[1][j];
+          const NodeVel* row = &halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
           for (int k = 0; k < st.Wz; ++k) {
-            const Real w = st.Weight(i, j, k);
-            const NodeVel& n = halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + k)];
-            v_pic += w * n.v1;
-            if constexpr (kMode != G2PMode::kApic) dv += w * (n.v1 - n.v0);
-            if constexpr (kMode == G2PMode::kApic && !kApicUsesGradient<K>) {
-              const Vec3 xi = (st.base + Vec3i(i, j, k)).template cast<Real>() * ctx.dx - x;
-              B += (w * n.v1) * xi.transpose();
+            const Real w = wxy * st.w[2][k];
+            const Real* v1 = row[k].v1;
+            for (int r = 0; r < 3; ++r) vpic[r] += w * v1[r];
+            if constexpr (kMode != G2PMode::kApic)
+              for (int r = 0; r < 3; ++r) dv[r] += w * (v1[r] - row[k].v0[r]);
+            if constexpr (kNeedB) {
+              const Real o[3] = {off[0][i], off[1][j], off[2][k]};
+              for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) bm[r][c] += w * v1[r] * o[c];
             }
-            if (velocity_gradient || (kMode == G2PMode::kApic && kApicUsesGradient<K>))
-              L += n.v1 * st.Gradient(i, j, k).transpose();
+            if (need_l) {
+              const Real gr[3] = {gxy_x * st.w[2][k], gxy_y * st.w[2][k], wxy * st.g[2][k]};
+              for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) l[r][c] += v1[r] * gr[c];
+            }
           }
+        }
+      const Vec3 v_pic(vpic[0], vpic[1], vpic[2]);
+      Mat3 L, B;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+          L(r, c) = l[r][c];
+          B(r, c) = bm[r][c];
+        }
       if constexpr (kMode == G2PMode::kApic) {
         P.v[p] = v_pic;  // APIC velocity (Jiang et al. 2015, eq. (8))
         if constexpr (kApicUsesGradient<K>) {
@@ -88,7 +107,7 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
         }
       } else {
         // FLIP increment (2.22) blended with PIC: v = a (v + sum N dv) + (1 - a) sum N v_{n+1}.
-        P.v[p] = alpha * (P.v[p] + dv) + (1.0 - alpha) * v_pic;
+        P.v[p] = alpha * (P.v[p] + Vec3(dv[0], dv[1], dv[2])) + (1.0 - alpha) * v_pic;
       }
       if (velocity_gradient) (*velocity_gradient)[p] = L;
       const Vec3 xn = x + ctx.dt * v_pic;  // x_{n+1} = x_n + sum N dx_i, dx_i = dt v_{n+1} (2.16)
@@ -116,9 +135,10 @@ void GradientBlocks(const StepContext& ctx, const SparseGrid& grid, const Partic
       Mat3 L = Mat3::Zero();
       for (int i = 0; i < st.W; ++i)
         for (int j = 0; j < st.W; ++j)
-          for (int k = 0; k < st.Wz; ++k)
-            L += halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + k)].v1 *
-                 st.Gradient(i, j, k).transpose();  // (2.17)
+          for (int k = 0; k < st.Wz; ++k) {
+            const Real* v1 = halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + k)].v1;
+            L += Vec3(v1[0], v1[1], v1[2]) * st.Gradient(i, j, k).transpose();  // (2.17)
+          }
       velocity_gradient[p] = L;
     }
   });

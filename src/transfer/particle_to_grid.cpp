@@ -29,7 +29,12 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
     st.Compute(x, ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
     const Vec3i lb = st.base - origin;
     const Real m = P.mass[p];
-    const Vec3 mv = m * P.v[p];
+    const Vec3& vp = P.v[p];
+    const Real mv[3] = {m * vp.x(), m * vp.y(), m * vp.z()};
+    // Node offsets x_i - x_p per axis (APIC affine term).
+    Real off[3][Stencil<kDim, K>::W];
+    for (int d = 0; d < 3; ++d)
+      for (int k = 0; k < (d < kDim ? st.W : 1); ++k) off[d][k] = (st.base[d] + k) * dx - x[d];
     Mat3 mC = Mat3::Zero();
     if constexpr (kApic) mC = m * P.C[p];
     // Internal force -V_p sigma_p grad N_ip with V_p = J V0 (2.11; sigma-bar m = tau V0).
@@ -39,27 +44,36 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
       neg_vs = -(P.volume0[p] * P.F[p].determinant()) * P.stress[p];
       fext = ctx.ramp * P.ext_force[p];  // particle tractions (App. B.2.9), ramped (App. B.2.3)
     }
-    for (int i = 0; i < st.W; ++i)
-      for (int j = 0; j < st.W; ++j)
+    for (int i = 0; i < st.W; ++i) {
+      for (int j = 0; j < st.W; ++j) {
+        const Real wxy = st.w[0][i] * st.w[1][j];
+        const Real gxy_x = st.g[0][i] * st.w[1][j];
+        const Real gxy_y = st.w[0][i] * st.g[1][j];
+        NodeAccum* row = &buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
         for (int k = 0; k < st.Wz; ++k) {
-          const Real w = st.Weight(i, j, k);
-          NodeAccum& a = buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + k)];
-          Vec3 mom = w * mv;
+          const Real w = wxy * st.w[2][k];
+          NodeAccum& a = row[k];
           if constexpr (kApic) {
-            const Vec3 xi = (st.base + Vec3i(i, j, k)).template cast<Real>() * dx - x;
-            mom += w * (mC * xi);  // APIC: m_p (v_p + C_p (x_i - x_p)) (Jiang et al. 2015, eq. (9))
+            // APIC: m_p (v_p + C_p (x_i - x_p)) (Jiang et al. 2015, eq. (9)).
+            const Real ox = off[0][i], oy = off[1][j], oz = off[2][k];
+            a.px += w * (mv[0] + mC(0, 0) * ox + mC(0, 1) * oy + mC(0, 2) * oz);
+            a.py += w * (mv[1] + mC(1, 0) * ox + mC(1, 1) * oy + mC(1, 2) * oz);
+            a.pz += w * (mv[2] + mC(2, 0) * ox + mC(2, 1) * oy + mC(2, 2) * oz);
+          } else {
+            a.px += w * mv[0];
+            a.py += w * mv[1];
+            a.pz += w * mv[2];
           }
-          a.px += mom.x();
-          a.py += mom.y();
-          a.pz += mom.z();
           if constexpr (kFull) {
+            const Real gx = gxy_x * st.w[2][k], gy = gxy_y * st.w[2][k], gz = wxy * st.g[2][k];
             a.m += w * m;
-            const Vec3 f = neg_vs * st.Gradient(i, j, k) + w * fext;
-            a.fx += f.x();
-            a.fy += f.y();
-            a.fz += f.z();
+            a.fx += neg_vs(0, 0) * gx + neg_vs(0, 1) * gy + neg_vs(0, 2) * gz + w * fext.x();
+            a.fy += neg_vs(1, 0) * gx + neg_vs(1, 1) * gy + neg_vs(1, 2) * gz + w * fext.y();
+            a.fz += neg_vs(2, 0) * gx + neg_vs(2, 1) * gy + neg_vs(2, 2) * gz + w * fext.z();
           }
         }
+      }
+    }
   }
   for (int a = 0; a < Pad::E; ++a)
     for (int b = 0; b < Pad::E; ++b)

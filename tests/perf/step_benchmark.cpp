@@ -1,0 +1,68 @@
+// Step throughput in particle-updates per second (Google Benchmark). A 3-D Neo-Hookean block of
+// about 100 000 particles (23^3 cells x 8 particles per cell, dx = 0.04 m), thrown at 2 m/s
+// through an open domain with gravity so that blocks appear and disappear. Arguments: shape
+// function, transfer, threads. Run: build/tests/perf/step_benchmark (see docs/benchmarks.md).
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include <string>
+
+#include "scene/scene.h"
+#include "step/step.h"
+
+namespace surge {
+namespace {
+
+std::string BlockScene(const char* shape, const char* transfer) {
+  return std::string(R"(name: bench_block
+dimension: 3
+time: {end: 100.0, cfl: 0.4}
+gravity: [0, -9.81, 0]
+grid: {cell_size: 0.04, shape_function: )") +
+         shape + ", transfer: " + transfer + R"(}
+domain: {min: [-10, -10, -10], max: [10, 10, 10]}
+materials:
+  rubber: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e6, poisson_ratio: 0.3}
+bodies:
+  - name: block
+    material: rubber
+    region: {box: {min: [0.013, 0.021, 0.007], max: [0.933, 0.941, 0.927]}}
+    particles_per_cell: 2
+    velocity: [2.0, 1.0, 0.5]
+output: {every: 0, energy: false}
+)";
+}
+
+void BM_Step(benchmark::State& bm, const char* shape, const char* transfer) {
+  const int threads = int(bm.range(0));
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  LoadedScene scene = LoadSceneFromString(BlockScene(shape, transfer), "bench_block.yaml");
+  const Pipeline pipeline = MakePipeline(scene.model);
+  Workspace work;
+  StepReport report;
+  for (int i = 0; i < 3; ++i) Step(scene.model, pipeline, scene.state, work, report);  // warm-up
+  report.stage_seconds.fill(0);
+  const size_t n = scene.state.particles.size();
+  int64_t steps = 0;
+  for (auto _ : bm) {
+    Step(scene.model, pipeline, scene.state, work, report);
+    ++steps;
+  }
+  bm.counters["particles"] = double(n);
+  bm.counters["updates_per_s"] = benchmark::Counter(double(n) * double(steps), benchmark::Counter::kIsRate);
+  for (int s = 0; s < kStageCount; ++s)
+    if (report.stage_seconds[s] > 0)
+      bm.counters[std::string("ms_") + StageName(Stage(s))] = 1e3 * report.stage_seconds[s] / double(steps);
+}
+
+BENCHMARK_CAPTURE(BM_Step, quadratic_apic, "quadratic_bspline", "apic")
+    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_Step, cubic_apic, "cubic_bspline", "apic")
+    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_Step, linear_flip, "linear", "flip")
+    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+}  // namespace
+}  // namespace surge
+
+BENCHMARK_MAIN();
