@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "support/run_scene.h"
 
@@ -21,6 +22,8 @@ TEST(TwoDisksTest, EnergyConservedThroughCollision) {
     min_kinetic = std::min(min_kinetic, r.energy.kinetic);
   });
   RecordProperty("energy_drift", std::to_string(max_drift));
+  std::printf("two disks: max |E - E0| / E0 = %.3f %%, min kinetic / E0 = %.3f\n", 100 * max_drift,
+              min_kinetic / e0.kinetic);
   EXPECT_LT(max_drift, 0.02);
   EXPECT_LT(min_kinetic, 0.5 * e0.kinetic) << "the disks should have collided";
 
