@@ -1,0 +1,167 @@
+// surge: command-line entry point (CLI11). Subcommands: run, check, info.
+#include <CLI/CLI.hpp>
+#include <tbb/version.h>
+
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/run.h"
+#include "core/log.h"
+#include "grid/sparse_grid.h"
+#include "io/results_writer.h"
+#include "scene/scene.h"
+#include "step/step.h"
+#include "surge/version.h"
+#include "transfer/transfer.h"
+
+namespace surge {
+namespace {
+
+std::string JoinArgs(int argc, char** argv) {
+  std::string s;
+  for (int i = 0; i < argc; ++i) {
+    if (i) s += ' ';
+    s += argv[i];
+  }
+  return s;
+}
+
+const char* ShapeName(ShapeFunction s) {
+  switch (s) {
+    case ShapeFunction::kLinear: return "linear";
+    case ShapeFunction::kGimp: return "gimp";
+    case ShapeFunction::kQuadraticBspline: return "quadratic_bspline";
+    case ShapeFunction::kCubicBspline: return "cubic_bspline";
+  }
+  return "?";
+}
+
+// `surge check`: validate, seed, build the first grid and print what a run would cost.
+int Check(const std::string& path, const std::vector<std::string>& overrides) {
+  LoadedScene scene = LoadScene(path, overrides);
+  const Model& m = scene.model;
+  const Particles& P = scene.state.particles;
+  SparseGrid grid;
+  RebuildGrid(m, P, grid);
+  StepContext ctx;
+  ctx.dx = m.dx;
+  ctx.inv_dx = 1 / m.dx;
+  ParticleToGrid(m, ctx, P, grid);
+  const Real dt = NextTimeStep(m, scene.state);
+  const double steps = dt > 0 ? m.time.end / dt : 0;
+  const double particle_bytes = double(P.size()) * (5 * 9 + 4 * 3 + 2) * 8;
+  const double grid_bytes = double(grid.block_count()) * kBlockNodes * (1 + 4 * 3) * 8;
+  std::printf("scene      %s (%s)\n", m.name.c_str(), path.c_str());
+  std::printf("dimension  %d-D%s, cell size %g m, %s, %s\n", m.dim,
+              m.dim == 2 ? " plane strain" : "", m.dx, ShapeName(m.shape),
+              m.transfer == TransferScheme::kApic     ? "APIC"
+              : m.transfer == TransferScheme::kFlip   ? "FLIP"
+                                                      : "PIC/FLIP");
+  std::printf("materials  %zu, bodies %zu\n", m.materials.size(), m.bodies.size());
+  std::printf("particles  %zu\n", P.size());
+  std::printf("grid       %zu active blocks (8^3 nodes), %zu nodes with mass\n",
+              grid.block_count(), grid.ActiveNodeCount());
+  std::printf("time step  %.4g s (CFL %.2f) -> about %.0f steps to t = %g s\n", dt, m.time.cfl,
+              steps, m.time.end);
+  std::printf("memory     about %.1f MB (particles %.1f MB, grid %.1f MB)\n",
+              (particle_bytes + grid_bytes) / 1e6, particle_bytes / 1e6, grid_bytes / 1e6);
+  std::printf("scene OK\n");
+  return kExitOk;
+}
+
+int Info() {
+  std::printf("surge %s (git %s)\n", SURGE_VERSION, SURGE_GIT_HASH);
+#ifdef NDEBUG
+  std::printf("build      release, C++%ld, GCC %d.%d\n", __cplusplus / 100 % 100, __GNUC__,
+              __GNUC_MINOR__);
+#else
+  std::printf("build      debug, C++%ld, GCC %d.%d\n", __cplusplus / 100 % 100, __GNUC__,
+              __GNUC_MINOR__);
+#endif
+  std::printf("precision  float64 particles and grid\n");
+  std::printf("threads    %u hardware threads (oneTBB %d.%d)\n", std::thread::hardware_concurrency(),
+              TBB_VERSION_MAJOR, TBB_VERSION_MINOR);
+  std::printf("OpenVDB    %s\n", OpenVdbVersion());
+  std::printf("HDF5       %s\n", Hdf5Version().c_str());
+  std::printf("Eigen      %d.%d.%d\n", EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION);
+  std::printf("CLI11      %s\n", CLI11_VERSION);
+  std::printf("shape functions: linear, gimp, quadratic_bspline, cubic_bspline\n");
+  std::printf("transfers:       flip, pic_flip, apic;  updates: usl, musl\n");
+  std::printf("materials:       linear_elastic, neo_hookean\n");
+  return kExitOk;
+}
+
+int Main(int argc, char** argv) {
+  CLI::App app{"Surge: material point method impact simulator"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("surge ") + SURGE_VERSION);
+
+  std::string scene_path, out_dir;
+  int threads = 0;
+  std::vector<std::string> overrides;
+  bool quiet = false, verbose = false;
+  std::string progress = "auto";
+
+  CLI::App* run = app.add_subcommand("run", "Run a scene and write results (HDF5 + XDMF)");
+  run->add_option("scene", scene_path, "Scene file (YAML)")->required();
+  run->add_option("--out,-o", out_dir, "Results folder (default: results/<scene name>)");
+  run->add_option("--threads,-t", threads, "Worker threads (default: all cores)")
+      ->check(CLI::Range(1, 1024));
+  run->add_option("--set", overrides, "Override a scene value: key.path=value (repeatable)");
+  run->add_option("--progress", progress, "Progress output: auto, terminal, plain, quiet")
+      ->check(CLI::IsMember({"auto", "terminal", "plain", "quiet"}));
+  run->add_flag("--quiet,-q", quiet, "Only errors and the summary");
+  run->add_flag("--verbose,-v", verbose, "Debug log messages");
+
+  CLI::App* check = app.add_subcommand("check", "Validate a scene and estimate its cost");
+  check->add_option("scene", scene_path, "Scene file (YAML)")->required();
+  check->add_option("--set", overrides, "Override a scene value: key.path=value (repeatable)");
+
+  CLI::App* info = app.add_subcommand("info", "Version, build options and library versions");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitBadInput;
+  }
+  SetLogLevel(verbose ? LogLevel::kDebug : quiet ? LogLevel::kWarn : LogLevel::kInfo);
+
+  try {
+    if (*info) return Info();
+    if (*check) return Check(scene_path, overrides);
+    LoadedScene scene = LoadScene(scene_path, overrides);
+    RunOptions options;
+    options.out_dir = out_dir.empty() ? "results/" + scene.model.name : out_dir;
+    options.threads = threads;
+    options.command_line = JoinArgs(argc, argv);
+    options.progress = quiet                    ? ProgressMode::kQuiet
+                       : progress == "terminal" ? ProgressMode::kTerminal
+                       : progress == "plain"    ? ProgressMode::kPlain
+                       : progress == "quiet"    ? ProgressMode::kQuiet
+                                                : ProgressMode::kAuto;
+    if (scene.model.shape == ShapeFunction::kLinear && scene.model.scheme == UpdateScheme::kUsl)
+      LogWarn("linear shape functions with update: usl suffer the cell-crossing instability; "
+              "consider grid.update: musl or a B-spline (docs/validation.md)");
+    LogInfo("running " + scene.model.name + ": " + std::to_string(scene.state.particles.size()) +
+            " particles, results in " + options.out_dir);
+    const RunSummary summary = RunScene(scene, options);
+    PrintSummary(scene, summary);
+    return summary.exit_code;
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitFailure;
+  }
+}
+
+}  // namespace
+}  // namespace surge
+
+int main(int argc, char** argv) { return surge::Main(argc, argv); }

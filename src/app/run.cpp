@@ -1,0 +1,210 @@
+// `surge run`: the frame loop around Step() (DESIGN §4, §7): output cadence, progress line,
+// health stop, Ctrl-C (finish the step, flush, exit non-zero).
+#include "app/run.h"
+
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "core/log.h"
+#include "grid/sparse_grid.h"
+#include "io/results_writer.h"
+#include "scene/scene.h"
+#include "step/stages.h"
+#include "step/step.h"
+#include "surge/version.h"
+
+namespace surge {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+
+extern "C" void OnSigint(int) { g_interrupted.store(true); }
+
+std::string UtcNow() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+std::string FormatDuration(double s) {
+  if (!(s >= 0) || s > 1e7) return "--:--";
+  const long t = long(s + 0.5);
+  return t >= 3600 ? fmt::format("{}:{:02}:{:02}", t / 3600, (t / 60) % 60, t % 60)
+                   : fmt::format("{:02}:{:02}", t / 60, t % 60);
+}
+
+class Progress {
+ public:
+  Progress(ProgressMode mode, Real end_time) : end_time_(end_time) {
+    if (mode == ProgressMode::kAuto) mode = isatty(STDERR_FILENO) ? ProgressMode::kTerminal : ProgressMode::kPlain;
+    mode_ = mode;
+    start_ = last_ = Clock::now();
+  }
+  void Update(Real t, int64_t step, size_t particles, bool force = false) {
+    if (mode_ == ProgressMode::kQuiet) return;
+    const auto now = Clock::now();
+    const double since = std::chrono::duration<double>(now - last_).count();
+    const double interval = mode_ == ProgressMode::kTerminal ? 0.25 : 10.0;
+    if (!force && since < interval) return;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double steps_per_s = (step - last_step_) / std::max(since, 1e-9);
+    const double updates = steps_per_s * double(particles);
+    const double eta = t > 0 ? elapsed * (end_time_ - t) / t : -1;
+    const std::string line = fmt::format(
+        "t = {:.4g}/{:.4g} s ({:5.1f}%)  step {}  {:.1f} steps/s  {:.2f} M particle-updates/s  "
+        "elapsed {}  ETA {}",
+        t, end_time_, 100.0 * t / end_time_, step, steps_per_s, updates * 1e-6,
+        FormatDuration(elapsed), FormatDuration(eta));
+    if (mode_ == ProgressMode::kTerminal)
+      std::fprintf(stderr, "\r%s\033[K", line.c_str());
+    else
+      std::fprintf(stderr, "%s\n", line.c_str());
+    std::fflush(stderr);
+    last_ = now;
+    last_step_ = step;
+    printed_ = true;
+  }
+  void Finish() {
+    if (mode_ == ProgressMode::kTerminal && printed_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  ProgressMode mode_;
+  Real end_time_;
+  Clock::time_point start_, last_;
+  int64_t last_step_ = 0;
+  bool printed_ = false;
+};
+
+}  // namespace
+
+RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
+  const Model& model = scene.model;
+  State& state = scene.state;
+  const int threads = options.threads > 0 ? options.threads
+                                          : int(std::max(1u, std::thread::hardware_concurrency()));
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+
+  RunMetadata meta;
+  meta.scene_path = scene.path;
+  meta.scene_text = scene.text;
+  meta.resolved_yaml = scene.resolved_yaml;
+  meta.version = SURGE_VERSION;
+  meta.git_hash = SURGE_GIT_HASH;
+  meta.command_line = options.command_line;
+  meta.start_time_utc = UtcNow();
+  meta.threads = threads;
+  ResultsWriter writer(options.out_dir, model.name, meta, model);
+
+  RunSummary summary;
+  const Pipeline pipeline = MakePipeline(model);
+  Workspace work;
+  StepReport report;
+  Progress progress(options.progress, model.time.end);
+
+  g_interrupted.store(false);
+  auto previous = std::signal(SIGINT, OnSigint);
+
+  auto write_snapshot = [&]() {
+    writer.WriteSnapshot(state);
+    if (model.output.vdb && work.grid.block_count() > 0) {
+      const std::string path = fmt::format("{}/{}_grid_{:06}.vdb", options.out_dir, model.name,
+                                           writer.snapshot_count() - 1);
+      ExportGridVdb(work.grid, model.dx, path);
+    }
+  };
+
+  if (model.output.energy) writer.AppendEnergy(ComputeEnergy(model, state));
+  write_snapshot();
+  Real next_output = model.output.every > 0 ? model.output.every : model.time.end;
+  const auto start = std::chrono::steady_clock::now();
+  double particle_steps = 0;
+  const Real end_tolerance = 1e-12 * model.time.end;
+  summary.exit_status = "completed";
+  while (state.time < model.time.end - end_tolerance) {
+    const size_t n = state.particles.size();
+    Step(model, pipeline, state, work, report);
+    if (report.health.status != HealthStatus::kOk) {
+      summary.exit_code = kExitUnhealthy;
+      summary.exit_status = "stopped at t = " + fmt::format("{:.6g}", state.time) + " s, step " +
+                            std::to_string(state.step) + ": " + report.health.detail +
+                            (report.health.particle_id >= 0
+                                 ? " (particle id " + std::to_string(report.health.particle_id) + ")"
+                                 : "");
+      LogError(summary.exit_status);
+      break;
+    }
+    particle_steps += double(n);
+    if (model.output.energy) writer.AppendEnergy(report.energy);
+    for (int f = 0; f < kFaceCount; ++f) {
+      const Real r = report.walls.force[f].norm();
+      if (r > summary.peak_wall_force[f]) {
+        summary.peak_wall_force[f] = r;
+        summary.peak_wall_time[f] = state.time;
+      }
+    }
+    if (report.removed_last_step > 0)
+      Log(LogLevel::kDebug, fmt::format("{} particles left the domain", report.removed_last_step));
+    const bool done = state.time >= model.time.end - end_tolerance;
+    if (state.time >= next_output - end_tolerance && !done) {
+      write_snapshot();
+      while (next_output <= state.time + end_tolerance) next_output += model.output.every;
+    }
+    progress.Update(state.time, state.step, state.particles.size());
+    if (g_interrupted.load()) {
+      summary.exit_code = kExitInterrupted;
+      summary.exit_status = "interrupted at t = " + fmt::format("{:.6g}", state.time) + " s";
+      LogWarn("interrupted: finishing the current step and flushing the results");
+      break;
+    }
+  }
+  progress.Update(state.time, state.step, state.particles.size(), /*force=*/true);
+  progress.Finish();
+  std::signal(SIGINT, previous);
+  write_snapshot();
+  summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.steps = state.step;
+  summary.end_time = state.time;
+  summary.particle_updates_per_second = particle_steps / std::max(summary.wall_seconds, 1e-9);
+  writer.Close(report.stage_seconds, state.step, summary.wall_seconds, summary.exit_status);
+  summary.h5_path = writer.h5_path();
+  summary.xmf_path = writer.xmf_path();
+  summary.snapshots = writer.snapshot_count();
+  return summary;
+}
+
+void PrintSummary(const LoadedScene& scene, const RunSummary& s) {
+  const Model& model = scene.model;
+  std::printf("\n== %s: %s\n", model.name.c_str(), s.exit_status.c_str());
+  std::printf("   simulated %.6g s in %lld steps, wall %.2f s, %.3g particle-updates/s\n",
+              s.end_time, static_cast<long long>(s.steps), s.wall_seconds,
+              s.particle_updates_per_second);
+  std::printf("   particles %zu (removed through open sides: %lld)\n", scene.state.particles.size(),
+              static_cast<long long>(scene.state.particles_removed));
+  bool any = false;
+  for (int f = 0; f < kFaceCount; ++f) {
+    if (model.walls[f].kind == WallKind::kOpen || f / 2 >= model.dim) continue;
+    if (!any) std::printf("   wall reaction forces (peak |R| over the run):\n");
+    any = true;
+    std::printf("     %-3s peak %12.5g N at t = %.4g s\n", FaceName(Face(f)), s.peak_wall_force[f],
+                s.peak_wall_time[f]);
+  }
+  std::printf("   results: %s (%d snapshots)\n            %s (open in ParaView)\n",
+              s.h5_path.c_str(), s.snapshots, s.xmf_path.c_str());
+}
+
+}  // namespace surge

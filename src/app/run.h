@@ -1,0 +1,49 @@
+// The frame loop of `surge run`: steps, output cadence, progress, Ctrl-C, exit codes.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "core/math.h"
+
+namespace surge {
+
+struct LoadedScene;
+
+// Exit codes of `surge run` (also documented in docs/getting-started.md).
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitFailure = 1,      // unexpected error (I/O, internal check)
+  kExitBadInput = 2,     // scene or command-line error
+  kExitUnhealthy = 3,    // the health check stopped the run (NaN, inverted particle, left domain)
+  kExitInterrupted = 130 // Ctrl-C: current step finished, results flushed
+};
+
+enum class ProgressMode { kAuto, kTerminal, kPlain, kQuiet };
+
+struct RunOptions {
+  std::string out_dir;       // results folder
+  int threads = 0;           // 0 = all cores
+  ProgressMode progress = ProgressMode::kAuto;
+  std::string command_line;  // recorded in the results
+};
+
+struct RunSummary {
+  int exit_code = kExitOk;
+  std::string exit_status;     // "completed", "interrupted", or the health diagnostic
+  int64_t steps = 0;
+  double wall_seconds = 0;
+  double particle_updates_per_second = 0;
+  Real end_time = 0;
+  std::array<Real, 6> peak_wall_force{};  // max |R| per face over the run [N]
+  std::array<Real, 6> peak_wall_time{};   // time of that peak [s]
+  std::string h5_path, xmf_path;
+  int snapshots = 0;
+};
+
+RunSummary RunScene(LoadedScene& scene, const RunOptions& options);
+
+// Prints the end-of-run summary (results location, steps, speed, wall forces, energies).
+void PrintSummary(const LoadedScene& scene, const RunSummary& summary);
+
+}  // namespace surge
