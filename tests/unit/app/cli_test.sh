@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# End-to-end checks of the surge command line: exit codes and messages (ctest label unit).
+# Usage: cli_test.sh <surge binary> <source dir>
+set -u
+surge=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail=0
+pass=0
+
+expect() {  # expect <name> <expected exit code> <regex on combined output> -- command...
+  local name=$1 code=$2 regex=$3
+  shift 4
+  local out rc
+  out=$("$@" 2>&1)
+  rc=$?
+  if [ "$rc" -ne "$code" ]; then
+    echo "FAIL $name: exit $rc, expected $code"; echo "$out" | tail -5; fail=$((fail + 1)); return
+  fi
+  if ! grep -Eq -- "$regex" <<<"$out"; then
+    echo "FAIL $name: output does not match /$regex/"; echo "$out" | tail -5; fail=$((fail + 1)); return
+  fi
+  echo "ok   $name"; pass=$((pass + 1))
+}
+
+expect info 0 'OpenVDB +10' -- "$surge" info
+expect check_good 0 'particles +1624' -- "$surge" check "$src/scenes/two_disks_2d.yaml"
+expect check_unknown_key 2 'unknown_key.yaml:[0-9]+:[0-9]+: .*' -- "$surge" check "$src/tests/data/bad_scenes/unknown_key.yaml"
+expect check_syntax 2 'syntax_error.yaml:[0-9]+' -- "$surge" check "$src/tests/data/bad_scenes/syntax_error.yaml"
+expect check_missing_file 2 'no_such.yaml' -- "$surge" check "$work/no_such.yaml"
+expect check_bad_set 2 'bodies\[0\]\.velocity|bodies\.0\.velocity' -- "$surge" check "$src/scenes/two_disks_2d.yaml" --set 'bodies.0.velocity=fast'
+cat > "$work/bad_cfl.yaml" <<'YAML'
+name: bad_cfl
+dimension: 2
+time: {end: 1.0, cfl: 3.0}
+grid: {cell_size: 0.1}
+domain: {min: [0, 0], max: [1, 1]}
+materials:
+  m: {model: neo_hookean, density: 1000, bulk_modulus: 1.0e6, shear_modulus: 1.0e5}
+bodies:
+  - {name: b, material: m, region: {box: {min: [0.2, 0.2], max: [0.4, 0.4]}}}
+YAML
+expect check_cfl_range 2 'bad_cfl.yaml:3:.*time\.cfl' -- "$surge" check "$work/bad_cfl.yaml"
+expect bad_option 2 '' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --threads 0
+expect no_subcommand 2 '' -- "$surge"
+expect run_small 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out" --set time.end=0.2 --threads 2 --progress plain
+[ -f "$work/out/two_disks_2d.h5" ] && [ -f "$work/out/two_disks_2d.xmf" ] && { echo "ok   results_files"; pass=$((pass + 1)); } \
+  || { echo "FAIL results_files: missing .h5 or .xmf"; fail=$((fail + 1)); }
+expect run_unwritable 1 'cannot create results folder' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out/two_disks_2d.h5/sub" --set time.end=0.01
+# Ctrl-C: the run finishes the step, flushes results and exits 130.
+"$surge" run "$src/scenes/elastic_drop_3d.yaml" --out "$work/int" --progress quiet > "$work/int.log" 2>&1 &
+pid=$!
+sleep 2
+kill -INT $pid
+wait $pid
+rc=$?
+if [ "$rc" -eq 130 ] && grep -q interrupted "$work/int.log" && [ -f "$work/int/elastic_drop_3d.xmf" ]; then
+  echo "ok   sigint"; pass=$((pass + 1))
+else
+  echo "FAIL sigint: exit $rc"; tail -3 "$work/int.log"; fail=$((fail + 1))
+fi
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
