@@ -47,6 +47,8 @@ expect no_subcommand 2 '' -- "$surge"
 expect run_small 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out" --set time.end=0.2 --threads 2 --progress plain
 [ -f "$work/out/two_disks_2d.h5" ] && [ -f "$work/out/two_disks_2d.xmf" ] && { echo "ok   results_files"; pass=$((pass + 1)); } \
   || { echo "FAIL results_files: missing .h5 or .xmf"; fail=$((fail + 1)); }
+expect run_vdb 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/vdb" --set time.end=0.05 --set output.vdb=true --progress quiet
+if ls "$work"/vdb/two_disks_2d_grid_*.vdb > /dev/null 2>&1; then echo "ok   vdb_files"; pass=$((pass + 1)); else echo "FAIL vdb_files"; fail=$((fail + 1)); fi
 expect run_unwritable 1 'cannot create results folder' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out/two_disks_2d.h5/sub" --set time.end=0.01
 # Ctrl-C: the run finishes the step, flushes results and exits 130.
 "$surge" run "$src/scenes/elastic_drop_3d.yaml" --out "$work/int" --progress quiet > "$work/int.log" 2>&1 &
