@@ -6,7 +6,7 @@ namespace surge {
 
 const char* StageName(Stage s) {
   static constexpr const char* kNames[kStageCount] = {
-      "rebuild_grid", "particle_to_grid", "grid_update", "grid_to_particle", "remap_momentum",
+      "rebuild_grid", "reorder_particles", "particle_to_grid", "grid_update", "grid_to_particle", "remap_momentum",
       "velocity_gradient", "update_stress", "domain_exit", "check_state", "energy"};
   return kNames[static_cast<int>(s)];
 }

@@ -7,6 +7,7 @@ namespace surge {
 
 enum class Stage : int {
   kRebuildGrid = 0,
+  kReorderParticles,  // every kReorderInterval steps
   kParticleToGrid,
   kGridUpdate,
   kGridToParticle,

@@ -1,8 +1,8 @@
 // THE pipeline. Stage order follows the seed cycle (Mast 2013, Fig. 2.1, eqs. (2.12)-(2.22));
 // docs/architecture.md has a paragraph per stage.
 //
-//   USL : RebuildGrid -> ParticleToGrid -> GridUpdate -> GridToParticle (+ L_p) -> UpdateStress
-//   MUSL: RebuildGrid -> ParticleToGrid -> GridUpdate -> GridToParticle -> RemapMomentum
+//   USL : RebuildGrid -> ReorderParticles -> ParticleToGrid -> GridUpdate -> GridToParticle (+ L_p) -> UpdateStress
+//   MUSL: RebuildGrid -> ReorderParticles -> ParticleToGrid -> GridUpdate -> GridToParticle -> RemapMomentum
 //         -> VelocityGradient -> UpdateStress
 //   then: DomainExit -> CheckState -> Energy
 #include "step/step.h"
@@ -19,6 +19,7 @@ namespace surge {
 Pipeline MakePipeline(const Model& model) {
   Pipeline p;
   p.push_back({Stage::kRebuildGrid, RebuildGridStage});
+  p.push_back({Stage::kReorderParticles, ReorderParticlesStage});
   p.push_back({Stage::kParticleToGrid, ParticleToGridStage});                  // (2.12)
   p.push_back({Stage::kGridUpdate, GridUpdateStage});                          // (2.13)-(2.14)
   if (model.scheme == UpdateScheme::kUsl) {

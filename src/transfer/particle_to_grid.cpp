@@ -44,32 +44,45 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
       neg_vs = -(P.volume0[p] * P.F[p].determinant()) * P.stress[p];
       fext = ctx.ramp * P.ext_force[p];  // particle tractions (App. B.2.9), ramped (App. B.2.3)
     }
+    // Terms that depend on (i, j) only are hoisted out of the k loop:
+    //   momentum  w (m v + mC (x_i - x_p)) = w (c_ij + mC[:,2] oz_k),  c_ij = m v + mC[:,0] ox_i + mC[:,1] oy_j
+    //   force     -V sigma grad N = w2_k a_ij + g2_k b_ij,  a_ij = S (gx_ij, gy_ij, 0), b_ij = wxy S[:,2]
     for (int i = 0; i < st.W; ++i) {
       for (int j = 0; j < st.W; ++j) {
         const Real wxy = st.w[0][i] * st.w[1][j];
-        const Real gxy_x = st.g[0][i] * st.w[1][j];
-        const Real gxy_y = st.w[0][i] * st.g[1][j];
+        Real c[3] = {mv[0], mv[1], mv[2]};
+        if constexpr (kApic)
+          for (int r = 0; r < 3; ++r) c[r] += mC(r, 0) * off[0][i] + mC(r, 1) * off[1][j];
+        Real fa[3] = {0, 0, 0}, fb[3] = {0, 0, 0};
+        if constexpr (kFull) {
+          const Real gx = st.g[0][i] * st.w[1][j], gy = st.w[0][i] * st.g[1][j];
+          for (int r = 0; r < 3; ++r) {
+            fa[r] = neg_vs(r, 0) * gx + neg_vs(r, 1) * gy;
+            fb[r] = wxy * neg_vs(r, 2);
+          }
+        }
         NodeAccum* row = &buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
         for (int k = 0; k < st.Wz; ++k) {
           const Real w = wxy * st.w[2][k];
           NodeAccum& a = row[k];
           if constexpr (kApic) {
             // APIC: m_p (v_p + C_p (x_i - x_p)) (Jiang et al. 2015, eq. (9)).
-            const Real ox = off[0][i], oy = off[1][j], oz = off[2][k];
-            a.px += w * (mv[0] + mC(0, 0) * ox + mC(0, 1) * oy + mC(0, 2) * oz);
-            a.py += w * (mv[1] + mC(1, 0) * ox + mC(1, 1) * oy + mC(1, 2) * oz);
-            a.pz += w * (mv[2] + mC(2, 0) * ox + mC(2, 1) * oy + mC(2, 2) * oz);
+            const Real oz = off[2][k];
+            a.px += w * (c[0] + mC(0, 2) * oz);
+            a.py += w * (c[1] + mC(1, 2) * oz);
+            a.pz += w * (c[2] + mC(2, 2) * oz);
           } else {
-            a.px += w * mv[0];
-            a.py += w * mv[1];
-            a.pz += w * mv[2];
+            a.px += w * c[0];
+            a.py += w * c[1];
+            a.pz += w * c[2];
           }
           if constexpr (kFull) {
-            const Real gx = gxy_x * st.w[2][k], gy = gxy_y * st.w[2][k], gz = wxy * st.g[2][k];
+            // Internal force -V_p sigma_p grad N_ip (2.11) plus the traction share w f_ext.
+            const Real w2 = st.w[2][k], g2 = st.g[2][k];
             a.m += w * m;
-            a.fx += neg_vs(0, 0) * gx + neg_vs(0, 1) * gy + neg_vs(0, 2) * gz + w * fext.x();
-            a.fy += neg_vs(1, 0) * gx + neg_vs(1, 1) * gy + neg_vs(1, 2) * gz + w * fext.y();
-            a.fz += neg_vs(2, 0) * gx + neg_vs(2, 1) * gy + neg_vs(2, 2) * gz + w * fext.z();
+            a.fx += w2 * fa[0] + g2 * fb[0] + w * fext.x();
+            a.fy += w2 * fa[1] + g2 * fb[1] + w * fext.y();
+            a.fz += w2 * fa[2] + g2 * fb[2] + w * fext.z();
           }
         }
       }

@@ -61,8 +61,13 @@ void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& gri
   grid.particle_block.resize(n);
   LookupBlocks(grid, grid.particle_block_coord.data(), n, grid.particle_block.data());
 
+  BinParticles(grid);
+}
+
+void BinParticles(SparseGrid& grid) {
   // Stable counting sort by owner block: order inside a block is particle order, so node sums
   // are independent of the thread count (spike note, "Determinism").
+  const size_t n = grid.particle_block.size();
   const size_t nb = grid.block_count();
   grid.block_begin.assign(nb + 1, 0);
   for (size_t p = 0; p < n; ++p) ++grid.block_begin[grid.particle_block[p] + 1];

@@ -16,6 +16,9 @@ namespace surge {
 // fields. Reads x. Writes grid topology, binning and node arrays.
 void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& grid);
 
+// Recomputes block_begin and sorted from grid.particle_block (stable counting sort).
+void BinParticles(SparseGrid& grid);
+
 // P2G (2.12): lumped mass, momentum (with the APIC affine term when selected), internal force
 // -sum V_p sigma_p grad N_ip and particle traction forces. Race-free and deterministic: blocks
 // of one colour never share nodes; every node sum has a fixed order for any thread count.
