@@ -1,5 +1,6 @@
 // XDMF 3 sidecar (xdmf.org, "XDMF Model and Format"): one Uniform Polyvertex grid per snapshot,
-// in a Temporal collection; every DataItem points into the .h5 by relative file name.
+// in a Temporal collection; every DataItem points into the .h5 by relative file name, so the
+// results folder can be moved or copied as a whole.
 #include "io/xdmf.h"
 
 #include <cstdio>
@@ -10,6 +11,23 @@
 
 namespace surge {
 namespace {
+
+// The text with the five XML special characters replaced by entities.
+std::string XmlEscape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
 
 void Item(std::ofstream& out, const std::string& h5, const std::string& path, size_t n, int cols,
           const char* type, int precision) {
@@ -32,6 +50,7 @@ void Attribute(std::ofstream& out, const std::string& h5, const std::string& gro
 
 void WriteXdmf(const std::string& xmf_path, const std::string& h5_name,
                const std::vector<XdmfSnapshot>& snapshots) {
+  const std::string h5 = XmlEscape(h5_name);
   const std::string tmp = xmf_path + ".tmp";
   {
     std::ofstream out(tmp);
@@ -47,14 +66,15 @@ void WriteXdmf(const std::string& xmf_path, const std::string& h5_name,
           << "      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << s.particles
           << "\" NodesPerElement=\"1\"/>\n"
           << "      <Geometry GeometryType=\"XYZ\">\n";
-      Item(out, h5_name, s.group + "/position", s.particles, 3, "Float", 8);
+      Item(out, h5, s.group + "/position", s.particles, 3, "Float", 8);
       out << "      </Geometry>\n";
-      Attribute(out, h5_name, s.group, "velocity", "Vector", s.particles, 3);
-      Attribute(out, h5_name, s.group, "stress", "Tensor6", s.particles, 6);
+      Attribute(out, h5, s.group, "velocity", "Vector", s.particles, 3);
+      Attribute(out, h5, s.group, "stress", "Tensor6", s.particles, 6);
       for (const char* scalar : {"pressure", "von_mises", "strain_volumetric", "strain_equivalent"})
-        Attribute(out, h5_name, s.group, scalar, "Scalar", s.particles, 0);
-      Attribute(out, h5_name, s.group, "material", "Scalar", s.particles, 0, "Int", 4);
-      Attribute(out, h5_name, s.group, "body", "Scalar", s.particles, 0, "Int", 4);
+        Attribute(out, h5, s.group, scalar, "Scalar", s.particles, 0);
+      Attribute(out, h5, s.group, "material", "Scalar", s.particles, 0, "Int", 4);
+      Attribute(out, h5, s.group, "body", "Scalar", s.particles, 0, "Int", 4);
+      Attribute(out, h5, s.group, "id", "Scalar", s.particles, 0, "Int", 8);
       out << "    </Grid>\n";
     }
     out << "    </Grid>\n  </Domain>\n</Xdmf>\n";
