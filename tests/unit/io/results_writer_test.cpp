@@ -350,7 +350,9 @@ TEST_F(ResultsWriterTest, KilledRunKeepsCompletedSnapshotsAndEnergy) {
 }
 
 // SIGKILL at random moments, mostly in the middle of writing a snapshot: every snapshot that
-// the .xmf lists must read back whole.
+// the .xmf lists must read back whole. A kill inside HDF5's flush can still break the file (see
+// hdf5_writer.cpp, "Crash safety"); with 6000-particle snapshots, whose time goes to raw data,
+// none of over 1000 kills did.
 TEST_F(ResultsWriterTest, SigkillDuringWritesLeavesListedSnapshotsReadable) {
   std::mt19937 rng(12345);
   std::uniform_int_distribution<int> delay_us(2000, 60000);
