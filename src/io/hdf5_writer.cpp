@@ -362,7 +362,8 @@ void ResultsWriter::WriteSnapshot(const State& state) {
       I.velocity[3 * p + d] = P.v[p][d];
     }
     const Mat3& s = P.stress[p];
-    const double voigt[6] = {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(0, 2), s(1, 2)};
+    // VTK/ParaView order xx yy zz xy yz xz, so ParaView's component labels are right.
+    const double voigt[6] = {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2)};
     std::copy(voigt, voigt + 6, &I.stress[6 * p]);
     I.pressure[p] = -s.trace() / 3.0;                        // > 0 in compression
     I.von_mises[p] = std::sqrt(1.5 * Dev(s).squaredNorm());  // q = sqrt(3/2 s:s)

@@ -54,6 +54,8 @@ State TinyState(size_t n) {
     P.F[0](0, 0) = 1.1;
     P.stress[0] = -3.0 * Mat3::Identity();
     P.stress[0](0, 1) = P.stress[0](1, 0) = 2.0;
+    P.stress[0](1, 2) = P.stress[0](2, 1) = 0.5;  // yz
+    P.stress[0](0, 2) = P.stress[0](2, 0) = 0.25;  // xz
   }
   return s;
 }
@@ -218,12 +220,13 @@ TEST_F(ResultsWriterTest, WritesLayoutValuesTimingAndXdmf) {
   EXPECT_EQ(pos[3 * 4 + 2], 0.25);
   EXPECT_EQ(ReadDoubles(f, s0 + "position")[3 * 4 + 2], -1.0);
   EXPECT_EQ(ReadDoubles(f, s0 + "velocity")[3 * 2], 1.0);
-  const auto stress = ReadDoubles(f, s0 + "stress");  // Voigt xx yy zz xy xz yz
+  const auto stress = ReadDoubles(f, s0 + "stress");  // xx yy zz xy yz xz (VTK order)
   EXPECT_EQ(std::vector<double>(stress.begin(), stress.begin() + 6),
-            (std::vector<double>{-3, -3, -3, 2, 0, 0}));
+            (std::vector<double>{-3, -3, -3, 2, 0.5, 0.25}));
   EXPECT_EQ(ReadDoubles(f, s0 + "pressure")[0], 3.0);
-  // q = sqrt(3/2 s:s), s the deviator: only the shear pair remains, s:s = 8, q = sqrt(12).
-  EXPECT_NEAR(ReadDoubles(f, s0 + "von_mises")[0], std::sqrt(12.0), 8 * kEps);
+  // q = sqrt(3/2 s:s), s the deviator: only the shear pairs remain,
+  // s:s = 2 (2^2 + 0.5^2 + 0.25^2) = 8.625, q = sqrt(12.9375).
+  EXPECT_NEAR(ReadDoubles(f, s0 + "von_mises")[0], std::sqrt(12.9375), 8 * kEps);
   EXPECT_NEAR(ReadDoubles(f, s0 + "strain_volumetric")[0], std::log(1.1), 4 * kEps);
   // Hencky eps = diag(ln 1.1, 0, 0), e = ln 1.1 (2/3, -1/3, -1/3): sqrt(2/3 e:e) = 2/3 ln 1.1.
   EXPECT_NEAR(ReadDoubles(f, s0 + "strain_equivalent")[0], 2.0 / 3.0 * std::log(1.1), 4 * kEps);
