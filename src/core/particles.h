@@ -1,6 +1,7 @@
 // Particle storage: structure of arrays (STYLE H.4). Index p is the same particle in every array.
 // SI units, tension positive (Mast 2013 convention).
 #pragma once
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -9,6 +10,15 @@
 
 namespace surge {
 
+// Per-particle history scalars of the plastic models. The meaning of each slot is fixed per
+// material model, in the model's header (materials/j2.h) and in docs/materials.md; models
+// without history leave all slots at zero.
+inline constexpr int kHistorySlots = 8;
+using History = std::array<Real, kHistorySlots>;
+
+// Design: material history lives in Particles (rather than in per-model SoA arrays) so that
+// reordering, compaction and checkpoints need no per-model code: every particle carries one b^e and
+// kHistorySlots scalars (136 bytes). The elastic and fluid updates never read or write them.
 struct Particles {
   // --- State: advanced by Step(), saved in checkpoints. ---
   std::vector<Vec3> x;       // position [m]                      written by GridToParticle
@@ -17,6 +27,11 @@ struct Particles {
   std::vector<Mat3> F;       // deformation gradient [-]          written by UpdateDeformation
   std::vector<Mat3> stress;  // Cauchy stress [Pa]                written by UpdateStress
   std::vector<Mat3> strain;  // accumulated small strain [-]      written by UpdateStress
+  // Material history (plastic models only; elastic and fluid models leave it at its initial value).
+  std::vector<Mat3> elastic_b;  // elastic left Cauchy-Green b^e = F^e F^eT [-] (Mast 2013 (3.30))
+                                //                                 written by UpdateStress (j2)
+  std::vector<History> history; // model-defined scalars, units per slot (see kHistorySlots)
+                                //                                 written by UpdateStress (j2)
   // --- Constant: set by the scene builder, never written by Step(). ---
   std::vector<Real> mass;         // [kg]
   std::vector<Real> volume0;      // reference volume [m^3]
@@ -34,6 +49,8 @@ struct Particles {
     F.resize(n);
     stress.resize(n);
     strain.resize(n);
+    elastic_b.resize(n, Mat3::Identity());
+    history.resize(n, History{});
     mass.resize(n);
     volume0.resize(n);
     ext_force.resize(n);
@@ -50,6 +67,8 @@ struct Particles {
     F[to] = F[from];
     stress[to] = stress[from];
     strain[to] = strain[from];
+    elastic_b[to] = elastic_b[from];
+    history[to] = history[from];
     mass[to] = mass[from];
     volume0[to] = volume0[from];
     ext_force[to] = ext_force[from];

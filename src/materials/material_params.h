@@ -2,7 +2,9 @@
 // Users give K and G (or E and nu); derived Lame constants are computed once by the builder.
 // Plasticity models of later issues add a struct here and a case in update_stress.cpp.
 #pragma once
+#include <cmath>
 #include <string>
+#include <type_traits>
 #include <variant>
 
 #include "core/math.h"
@@ -23,7 +25,34 @@ struct NeoHookeanParams {
   Real shear_modulus = 0;  // G [Pa]
 };
 
-using MaterialParams = std::variant<LinearElasticParams, NeoHookeanParams>;
+// J2 (von Mises) plasticity at finite strain with linear isotropic and linear (Prager) kinematic
+// hardening (Mast 2013 §3.5, eqs. (3.69)-(3.83); spec §2.4). Hencky elasticity in Kirchhoff
+// stress, tau = K tr(eps_e) 1 + 2G dev(eps_e); history layout in materials/j2.h.
+struct J2Params {
+  Real bulk_modulus = 0;         // K [Pa]
+  Real shear_modulus = 0;        // G [Pa]
+  Real yield_stress = 0;         // sigma_Y, uniaxial [Pa]
+  Real isotropic_hardening = 0;  // k, slope of uniaxial stress vs plastic strain [Pa]
+  Real kinematic_hardening = 0;  // H, Prager modulus, back stress = 2/3 H alpha_kin [Pa]
+};
+
+// Pressure law of the Newtonian fluid.
+enum class EquationOfState {
+  kLinear,  // sigma_m = K ln(J) / J (Mast 2013 eq. (6.1) with theta = ln J)
+  kTait     // p = B [(rho/rho0)^gamma - 1], B = K / gamma (Monaghan 1994)
+};
+
+// Weakly compressible Newtonian fluid (Mast 2013 §6.1, eqs. (6.1)-(6.2); spec §2.3):
+// sigma = sigma_m(J) 1 + 2 mu d.
+struct NewtonianFluidParams {
+  Real bulk_modulus = 0;  // K = rho0 c0^2 [Pa]
+  Real viscosity = 0;     // dynamic viscosity mu [Pa s]
+  EquationOfState equation_of_state = EquationOfState::kLinear;
+  Real tait_gamma = 7;    // Tait exponent gamma [-] (kTait only)
+};
+
+using MaterialParams =
+    std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams>;
 
 struct Material {
   std::string name;
@@ -35,10 +64,16 @@ struct Material {
 inline Real LameLambda(Real bulk, Real shear) { return bulk - 2.0 * shear / 3.0; }
 
 // Dilatational (P-)wave speed c = sqrt((K + 4G/3)/rho_0), used by the CFL rule (spec §1.7).
+// A fluid has no shear modulus: c = sqrt(K/rho_0), the speed at the reference density (the Tait
+// law stiffens under compression, by (rho/rho0)^((gamma-1)/2): 3 % at 1 % compression).
 inline Real WaveSpeed(const Material& m) {
   return std::visit(
       [&](const auto& p) {
-        return std::sqrt((p.bulk_modulus + 4.0 * p.shear_modulus / 3.0) / m.density);
+        if constexpr (std::is_same_v<std::decay_t<decltype(p)>, NewtonianFluidParams>) {
+          return std::sqrt(p.bulk_modulus / m.density);
+        } else {
+          return std::sqrt((p.bulk_modulus + 4.0 * p.shear_modulus / 3.0) / m.density);
+        }
       },
       m.params);
 }

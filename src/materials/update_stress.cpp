@@ -4,8 +4,10 @@
 #include <array>
 
 #include "core/parallel.h"
+#include "materials/j2.h"
 #include "materials/linear_elastic.h"
 #include "materials/neo_hookean.h"
+#include "materials/newtonian_fluid.h"
 
 namespace surge {
 namespace {
@@ -44,6 +46,26 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        P.stress[p] = NeoHookeanStress(params, P.F[p]);
                      });
                    },
+                   [&](const J2Params& params) {
+                     ParallelFor(count, 256, [&](size_t k) {
+                       const size_t p = g.begin + k;
+                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
+                       P.F[p] = f * P.F[p];
+                       P.strain[p] += Sym(f - Mat3::Identity());
+                       J2Update(params, f, P.F[p].determinant(), P.elastic_b[p], P.history[p],
+                                P.stress[p]);
+                     });
+                   },
+                   [&](const NewtonianFluidParams& params) {
+                     ParallelFor(count, 1024, [&](size_t k) {
+                       const size_t p = g.begin + k;
+                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
+                       P.F[p] = f * P.F[p];
+                       P.strain[p] += Sym(f - Mat3::Identity());
+                       P.stress[p] = NewtonianFluidStress(params, P.F[p].determinant(),
+                                                          velocity_gradient[p]);  // (6.1)-(6.2)
+                     });
+                   },
                },
                model.materials[g.material].params);
   }
@@ -56,8 +78,21 @@ Real StrainEnergyDensity(const Material& material, const Mat3& F, const Mat3& st
                           return LinearElasticEnergy(stress, strain);
                         },
                         [&](const NeoHookeanParams& p) { return NeoHookeanEnergy(p, F); },
+                        [&](const J2Params& p) { return J2Energy(p, F.determinant(), stress); },
+                        [&](const NewtonianFluidParams& p) {
+                          return NewtonianFluidEnergy(p, F.determinant());
+                        },
                     },
                     material.params);
+}
+
+void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_b,
+                    History& history) {
+  history = History{};
+  elastic_b = Mat3::Identity();
+  if (const auto* j2 = std::get_if<J2Params>(&material.params)) {
+    elastic_b = J2ElasticBFromStress(*j2, stress);  // at F = I, tau = sigma
+  }
 }
 
 Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,

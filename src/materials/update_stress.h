@@ -10,10 +10,15 @@
 namespace surge {
 
 // F_{n+1} = (I + dt L) F_n (2.18), then the group's constitutive update. Reads L, F, stress,
-// strain; writes F, stress, strain.
+// strain, elastic_b, history; writes F, stress, strain and (plastic models) elastic_b, history.
 void UpdateStress(const Model& model, const StepContext& ctx,
                   const std::vector<Mat3>& velocity_gradient,
                   const std::vector<MaterialGroup>& groups, Particles& particles);
+
+// Material history consistent with a prescribed initial Cauchy stress at F = I (a geostatic
+// start): b^e from the elastic compliance for J2, identity otherwise; history slots zero.
+void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_b,
+                    History& history);
 
 // Stored elastic energy sum psi V0 [J] (per metre of thickness in 2-D), summed in fixed chunks.
 Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,

@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "materials/update_stress.h"
 #include "mesh/mesh.h"
 #include "scene/particle_sampling.h"
 #include "scene/scene_error.h"
@@ -22,13 +23,24 @@ MaterialParams MakeLinearElastic(const MaterialSpec& m) {
 MaterialParams MakeNeoHookean(const MaterialSpec& m) {
   return NeoHookeanParams{m.bulk_modulus, m.shear_modulus};
 }
+MaterialParams MakeJ2(const MaterialSpec& m) {
+  return J2Params{m.bulk_modulus, m.shear_modulus, m.yield_stress, m.isotropic_hardening,
+                  m.kinematic_hardening};
+}
+MaterialParams MakeNewtonianFluid(const MaterialSpec& m) {
+  return NewtonianFluidParams{m.bulk_modulus, m.viscosity, m.equation_of_state, m.tait_gamma};
+}
 
 // The one table of material kinds. A new model adds a MaterialModel value, a params struct in
 // materials/material_params.h and a row here. Geostatic initial stress is refused for
-// hyperelastic models: their stress is a function of F, which starts at I.
+// hyperelastic models and fluids: their stress is a function of F (and L), and F starts at I.
+// j2 accepts it: its stress is a function of the elastic b^e, which InitialHistory sets from
+// the prescribed stress.
 constexpr MaterialKind kMaterialKinds[] = {
     {"linear_elastic", MaterialModel::kLinearElastic, true, &MakeLinearElastic},
     {"neo_hookean", MaterialModel::kNeoHookean, false, &MakeNeoHookean},
+    {"j2", MaterialModel::kJ2, true, &MakeJ2},
+    {"newtonian_fluid", MaterialModel::kNewtonianFluid, false, &MakeNewtonianFluid},
 };
 
 // Total particles allowed in one scene, and lattice candidates scanned for one body.
@@ -233,6 +245,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
         P.F[next] = Mat3::Identity();
         P.stress[next] = s.stress[k];
         P.strain[next] = Mat3::Zero();
+        InitialHistory(model.materials[m], s.stress[k], P.elastic_b[next], P.history[next]);
         P.mass[next] = s.mass;
         P.volume0[next] = s.volume0;
         P.ext_force[next] = s.ext_force[k];

@@ -45,6 +45,8 @@ constexpr EnumName<UpdateScheme> kUpdateNames[] = {{"usl", UpdateScheme::kUsl},
                                                    {"musl", UpdateScheme::kMusl}};
 constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
+constexpr EnumName<EquationOfState> kEosNames[] = {{"linear", EquationOfState::kLinear},
+                                                   {"tait", EquationOfState::kTait}};
 constexpr EnumName<WallKind> kWallNames[] = {{"open", WallKind::kOpen},
                                              {"slip", WallKind::kSlip},
                                              {"no_slip", WallKind::kNoSlip},
@@ -344,11 +346,27 @@ Wall Parser::ParseWall(const YAML::Node& n, const std::string& path) const {
   return wall;
 }
 
+// Keys each material model accepts (the elastic pair is either (K, G) or (E, nu)).
+std::vector<std::string> MaterialKeys(MaterialModel model) {
+  const std::vector<std::string> elastic = {"model",        "density",      "youngs_modulus",
+                                            "poisson_ratio", "bulk_modulus", "shear_modulus"};
+  switch (model) {
+    case MaterialModel::kJ2: {
+      std::vector<std::string> keys = elastic;
+      keys.insert(keys.end(), {"yield_stress", "isotropic_hardening", "kinematic_hardening"});
+      return keys;
+    }
+    case MaterialModel::kNewtonianFluid:
+      return {"model", "density", "bulk_modulus", "viscosity", "equation_of_state", "tait_gamma"};
+    default:
+      return elastic;
+  }
+}
+
 MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path) const {
   MaterialSpec m;
   m.loc = Loc(n, path);
-  ExpectMap(n, path,
-            {"model", "density", "youngs_modulus", "poisson_ratio", "bulk_modulus", "shear_modulus"});
+  if (!n.IsMap()) Fail(n, path, "expected a map with keys model, density, ..., got " + Describe(n));
   const YAML::Node model = Need(n, path, "model");
   std::vector<std::string> names;
   for (const MaterialKind& k : MaterialKinds()) names.push_back(k.name);
@@ -364,7 +382,25 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
     Fail(model, Child(path, "model"),
          "unknown material model '" + model.Scalar() + "' (expected one of: " + Join(names) + ")");
   }
+  ExpectMap(n, path, MaterialKeys(m.model));
   m.density = Positive(Need(n, path, "density"), Child(path, "density"), "kg/m^3");
+
+  if (m.model == MaterialModel::kNewtonianFluid) {
+    m.bulk_modulus = Positive(Need(n, path, "bulk_modulus"), Child(path, "bulk_modulus"), "Pa");
+    m.viscosity = NonNegative(Need(n, path, "viscosity"), Child(path, "viscosity"), "Pa s");
+    if (n["equation_of_state"]) {
+      m.equation_of_state =
+          Enum(n["equation_of_state"], Child(path, "equation_of_state"), kEosNames);
+    }
+    if (n["tait_gamma"]) {
+      if (m.equation_of_state != EquationOfState::kTait) {
+        Fail(n["tait_gamma"], Child(path, "tait_gamma"),
+             "tait_gamma applies only with equation_of_state: tait");
+      }
+      m.tait_gamma = Ranged(n["tait_gamma"], Child(path, "tait_gamma"), "-", 1, false, kInf, false);
+    }
+    return m;
+  }
 
   const bool kg = n["bulk_modulus"] || n["shear_modulus"];
   const bool enu = n["youngs_modulus"] || n["poisson_ratio"];
@@ -390,6 +426,17 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
     // (Bonet & Wood 2008, eqs. (6.36)-(6.37) in Lame form).
     m.bulk_modulus = m.youngs_modulus / (3.0 * (1.0 - 2.0 * m.poisson_ratio));
     m.shear_modulus = m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio));
+  }
+  if (m.model == MaterialModel::kJ2) {
+    m.yield_stress = Positive(Need(n, path, "yield_stress"), Child(path, "yield_stress"), "Pa");
+    if (n["isotropic_hardening"]) {
+      m.isotropic_hardening =
+          NonNegative(n["isotropic_hardening"], Child(path, "isotropic_hardening"), "Pa");
+    }
+    if (n["kinematic_hardening"]) {
+      m.kinematic_hardening =
+          NonNegative(n["kinematic_hardening"], Child(path, "kinematic_hardening"), "Pa");
+    }
   }
   return m;
 }
@@ -850,12 +897,28 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     e << YAML::Key << m.name << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "model" << YAML::Value << FindMaterialKind(m.model).name;
     e << YAML::Key << "density" << YAML::Value << Num(m.density);
+    if (m.model == MaterialModel::kNewtonianFluid) {
+      e << YAML::Key << "bulk_modulus" << YAML::Value << Num(m.bulk_modulus);
+      e << YAML::Key << "viscosity" << YAML::Value << Num(m.viscosity);
+      e << YAML::Key << "equation_of_state" << YAML::Value
+        << NameOf(kEosNames, m.equation_of_state);
+      if (m.equation_of_state == EquationOfState::kTait) {
+        e << YAML::Key << "tait_gamma" << YAML::Value << Num(m.tait_gamma);
+      }
+      e << YAML::EndMap;
+      continue;
+    }
     if (m.given_as_youngs) {
       e << YAML::Key << "youngs_modulus" << YAML::Value << Num(m.youngs_modulus);
       e << YAML::Key << "poisson_ratio" << YAML::Value << Num(m.poisson_ratio);
     } else {
       e << YAML::Key << "bulk_modulus" << YAML::Value << Num(m.bulk_modulus);
       e << YAML::Key << "shear_modulus" << YAML::Value << Num(m.shear_modulus);
+    }
+    if (m.model == MaterialModel::kJ2) {
+      e << YAML::Key << "yield_stress" << YAML::Value << Num(m.yield_stress);
+      e << YAML::Key << "isotropic_hardening" << YAML::Value << Num(m.isotropic_hardening);
+      e << YAML::Key << "kinematic_hardening" << YAML::Value << Num(m.kinematic_hardening);
     }
     e << YAML::EndMap;
   }

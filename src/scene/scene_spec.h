@@ -48,7 +48,7 @@ struct DomainSpec {
 
 // Material models known to the scene file; names and constructors live in the one table in
 // scene_builder.cpp (MaterialKinds()).
-enum class MaterialModel { kLinearElastic, kNeoHookean };
+enum class MaterialModel { kLinearElastic, kNeoHookean, kJ2, kNewtonianFluid };
 
 struct MaterialSpec {
   std::string name;  // the key under `materials`
@@ -60,6 +60,14 @@ struct MaterialSpec {
   Real shear_modulus = 0;  // G [Pa]
   Real youngs_modulus = 0; // E [Pa] (given_as_youngs only)
   Real poisson_ratio = 0;  // nu [-] (given_as_youngs only)
+  // j2 (Mast 2013 §3.5):
+  Real yield_stress = 0;         // sigma_Y, required, > 0 [Pa]
+  Real isotropic_hardening = 0;  // k, >= 0 [Pa]
+  Real kinematic_hardening = 0;  // H, >= 0 [Pa]
+  // newtonian_fluid (Mast 2013 §6.1); bulk_modulus above is required, shear_modulus unused:
+  Real viscosity = 0;  // dynamic viscosity mu, >= 0 [Pa s]
+  EquationOfState equation_of_state = EquationOfState::kLinear;
+  Real tait_gamma = 7;  // > 1 [-] (tait only)
   SourceLoc loc;
 };
 

@@ -7,6 +7,8 @@
 #include <numeric>
 #include <string>
 
+#include <Eigen/Eigenvalues>
+
 #include "scene/scene.h"
 
 namespace surge {
@@ -162,6 +164,24 @@ TEST(SceneBuilderTest, GeostaticStressAtKnownDepths) {
     EXPECT_NEAR(P.stress[p](0, 1), 0.0, 1e-9);
   }
   EXPECT_NEAR(P.stress[0](1, 1), -2000.0 * 10.0 * 0.9375, 1e-9);  // bottom layer
+}
+
+TEST(SceneBuilderTest, GeostaticJ2StateReproducesTheStress) {
+  std::string text = OneBody(3, "{box: {min: [0, 0, 0], max: [1, 1, 1]}}", 0.25,
+                             "    initial_stress: {geostatic: {k0: 0.5}}\n", "gravity: [0, -10, 0]\n");
+  text.replace(text.find("{model: linear_elastic"), std::string("{model: linear_elastic").size(),
+               "{model: j2, yield_stress: 1.0e6");
+  const LoadedScene s = LoadSceneFromString(text, "s.yaml");
+  const Particles& P = s.state.particles;
+  for (size_t p = 0; p < P.size(); ++p) {
+    // Hencky elasticity at F = I: tau = sigma = K tr(eps) 1 + 2G dev(eps), eps = 1/2 ln b^e.
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(P.elastic_b[p]);
+    const Vec3 e = 0.5 * eig.eigenvalues().array().log();
+    const Mat3 eps = eig.eigenvectors() * e.asDiagonal() * eig.eigenvectors().transpose();
+    const Mat3 tau = 1.0e7 * eps.trace() * Mat3::Identity() + 2 * 5.0e6 * Dev(eps);
+    EXPECT_LE((tau - P.stress[p]).norm(), 1e-9 * (1 + P.stress[p].norm())) << p;
+    EXPECT_EQ(P.history[p], History{});
+  }
 }
 
 TEST(SceneBuilderTest, GeostaticStressFollowsAnInclinedGravity) {

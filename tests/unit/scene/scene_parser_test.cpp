@@ -187,7 +187,60 @@ TEST(SceneParserTest, PoissonRatioOneHalf) {
 
 TEST(SceneParserTest, UnknownMaterialModel) {
   ExpectError(Replace(kBase3, "model: linear_elastic", "model: linear_elastic_2d"), 7,
-              "materials.steel.model", "expected one of: linear_elastic, neo_hookean");
+              "materials.steel.model",
+              "expected one of: linear_elastic, neo_hookean, j2, newtonian_fluid");
+}
+
+// Material line 7 of kBase3 with another model.
+std::string WithMaterial(const std::string& material) {
+  return Replace(kBase3,
+                 "{model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3}",
+                 material);
+}
+
+TEST(SceneParserTest, J2NeedsAYieldStress) {
+  ExpectError(WithMaterial("{model: j2, density: 2710, bulk_modulus: 6.86e10, shear_modulus: 2.33e10}"),
+              7, "materials.steel.yield_stress", "missing required key 'yield_stress'");
+  ExpectError(WithMaterial("{model: j2, density: 2710, bulk_modulus: 6.86e10, shear_modulus: 2.33e10, "
+                           "yield_stress: 0}"),
+              7, "materials.steel.yield_stress", "must be > 0 [Pa], got 0");
+}
+
+TEST(SceneParserTest, J2NegativeHardening) {
+  ExpectError(WithMaterial("{model: j2, density: 2710, youngs_modulus: 7e10, poisson_ratio: 0.33, "
+                           "yield_stress: 6.1e7, kinematic_hardening: -1e9}"),
+              7, "materials.steel.kinematic_hardening", "must be >= 0 [Pa], got -1e9");
+}
+
+TEST(SceneParserTest, PlasticKeysOnAnElasticModel) {
+  ExpectError(Replace(kBase3, "poisson_ratio: 0.3}", "poisson_ratio: 0.3, yield_stress: 1e6}"), 7,
+              "materials.steel.yield_stress", "unknown key 'yield_stress'");
+}
+
+TEST(SceneParserTest, FluidKeys) {
+  const std::string water = "{model: newtonian_fluid, density: 997.5, bulk_modulus: 2e9, ";
+  ExpectError(WithMaterial(water + "viscosity: 0.001, shear_modulus: 1e6}"), 7,
+              "materials.steel.shear_modulus",
+              "unknown key 'shear_modulus' (expected one of: model, density, bulk_modulus, "
+              "viscosity, equation_of_state, tait_gamma)");
+  ExpectError(WithMaterial(water + "viscosity: -0.001}"), 7, "materials.steel.viscosity",
+              "must be >= 0 [Pa s], got -0.001");
+  ExpectError(WithMaterial(water + "equation_of_state: tait}"), 7, "materials.steel.viscosity",
+              "missing required key 'viscosity'");
+  ExpectError(WithMaterial(water + "viscosity: 0, equation_of_state: ideal_gas}"), 7,
+              "materials.steel.equation_of_state",
+              "unknown value 'ideal_gas' (expected one of: linear, tait)");
+  ExpectError(WithMaterial(water + "viscosity: 0, tait_gamma: 7}"), 7, "materials.steel.tait_gamma",
+              "tait_gamma applies only with equation_of_state: tait");
+  ExpectError(WithMaterial(water + "viscosity: 0, equation_of_state: tait, tait_gamma: 1}"), 7,
+              "materials.steel.tait_gamma", "must be > 1 [-], got 1");
+}
+
+TEST(SceneParserTest, GeostaticOnFluid) {
+  const std::string text =
+      WithMaterial("{model: newtonian_fluid, density: 1000, bulk_modulus: 2e7, viscosity: 0}") +
+      "    initial_stress: {geostatic: {k0: 1}}\n" + "gravity: [0, -10, 0]\n";
+  ExpectError(text, 12, "bodies[0].initial_stress.geostatic", "newtonian_fluid");
 }
 
 TEST(SceneParserTest, DuplicateBodyName) {
@@ -480,6 +533,20 @@ TEST(SceneResolvedYamlTest, RereadsToTheSameScene) {
     EXPECT_EQ(a.model.walls[f].kind, b.model.walls[f].kind);
     EXPECT_EQ(a.model.walls[f].friction, b.model.walls[f].friction);
     EXPECT_EQ(a.model.walls[f].separable, b.model.walls[f].separable);
+  }
+}
+
+TEST(SceneResolvedYamlTest, RereadsPlasticAndFluidMaterials) {
+  for (const std::string material :
+       {"{model: j2, density: 2710, youngs_modulus: 7e10, poisson_ratio: 0.33, yield_stress: 6.1e7, "
+        "isotropic_hardening: 2e8}",
+        "{model: newtonian_fluid, density: 997.5, bulk_modulus: 2e7, viscosity: 0.001, "
+        "equation_of_state: tait, tait_gamma: 7.15}",
+        "{model: newtonian_fluid, density: 997.5, bulk_modulus: 2e7, viscosity: 0}"}) {
+    const LoadedScene a = LoadSceneFromString(WithMaterial(material), "s.yaml");
+    const LoadedScene b = LoadSceneFromString(a.resolved_yaml, "resolved.yaml");
+    EXPECT_EQ(b.resolved_yaml, a.resolved_yaml);
+    EXPECT_EQ(WaveSpeed(a.model.materials[0]), WaveSpeed(b.model.materials[0]));
   }
 }
 

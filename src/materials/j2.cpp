@@ -1,0 +1,124 @@
+// J2 plasticity at finite strain: trial b^e, Hencky strain, radial return in Kirchhoff stress
+// (Mast 2013 §3.5 and Table 3.4; spec §2.4). The only Eigen eigen-solver user besides the other
+// plastic models.
+#include "materials/j2.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <cmath>
+
+namespace surge {
+namespace {
+
+const Real kSqrtTwoThirds = std::sqrt(2.0 / 3.0);
+
+// exp(2 eps) of a symmetric tensor, through its spectral decomposition (Mast 2013 (4.40)).
+Mat3 ExpTwice(const Mat3& eps) {
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(eps);
+  const Mat3& Q = eig.eigenvectors();
+  const Vec3 e = (2.0 * eig.eigenvalues()).array().exp();
+  return Q * e.asDiagonal() * Q.transpose();
+}
+
+void StoreBackStress(const Mat3& beta, History& h) {
+  h[kJ2BackStress + 0] = beta(0, 0);
+  h[kJ2BackStress + 1] = beta(1, 1);
+  h[kJ2BackStress + 2] = beta(2, 2);
+  h[kJ2BackStress + 3] = beta(0, 1);
+  h[kJ2BackStress + 4] = beta(1, 2);
+  h[kJ2BackStress + 5] = beta(0, 2);
+}
+
+}  // namespace
+
+Mat3 J2BackStressOf(const History& h) {
+  Mat3 beta;
+  beta << h[kJ2BackStress + 0], h[kJ2BackStress + 3], h[kJ2BackStress + 5],  //
+      h[kJ2BackStress + 3], h[kJ2BackStress + 1], h[kJ2BackStress + 4],       //
+      h[kJ2BackStress + 5], h[kJ2BackStress + 4], h[kJ2BackStress + 2];
+  return beta;
+}
+
+// Finite-deformation return (Table 3.4) specialised to J2, where dgamma is closed-form (3.83).
+//
+// Kinematic hardening departs from the seed's principal-space algorithm, which assumes that all
+// tensors share the trial eigenbasis: a back stress generally does not. We therefore (a) carry
+// beta with the rotation R of the polar decomposition f = R U (a Green-Naghdi-type transport,
+// our choice: it makes the update objective), and (b) return the full relative stress
+// eta = s - beta in the trial eigenframe. Without back stress eta is diagonal there and the
+// update is exactly the seed's principal-space return.
+void J2Update(const J2Params& p, const Mat3& f, Real J, Mat3& elastic_b, History& h,
+              Mat3& stress) {
+  const Real K = p.bulk_modulus;
+  const Real G = p.shear_modulus;
+  const Real H = p.kinematic_hardening;
+  const Real k = p.isotropic_hardening;
+
+  // Trial elastic left Cauchy-Green tensor b^e_tr = f b^e_n f^T (3.35).
+  const Mat3 b_trial = Sym(f * elastic_b * f.transpose());
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(b_trial);
+  const Mat3 Q = eig.eigenvectors();
+  // Principal Hencky strains eps_i = 1/2 ln b_i (3.34), spec §9 erratum 2.
+  const Vec3 eps = 0.5 * eig.eigenvalues().array().log();
+  const Real theta = eps.sum();
+  // Principal trial Kirchhoff stress tau_i = K tr(eps) + 2G (eps_i - tr(eps)/3) (Table 3.4, 4).
+  const Vec3 s_trial = 2.0 * G * (eps.array() - theta / 3.0).matrix();
+  Mat3 tau_hat = (s_trial.array() + K * theta).matrix().asDiagonal();
+
+  Mat3 beta = Mat3::Zero();
+  if (H > 0) {
+    Eigen::JacobiSVD<Mat3> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Mat3 R = svd.matrixU() * svd.matrixV().transpose();  // f = R U, det f > 0
+    beta = R * J2BackStressOf(h) * R.transpose();
+  }
+  const Mat3 beta_hat = Q.transpose() * beta * Q;
+
+  // Trial relative stress eta_tr = s_tr + kappa_kin_n, kappa_kin = -beta (3.70), (3.77).
+  const Mat3 eta = Mat3(s_trial.asDiagonal()) - beta_hat;
+  const Real eta_norm = eta.norm();
+  Real& alpha = h[kJ2PlasticStrain];
+  // F_tr = ||eta_tr|| - sqrt(2/3) (sigma_Y + k alpha_n) (3.82).
+  const Real f_trial = eta_norm - kSqrtTwoThirds * (p.yield_stress + k * alpha);
+
+  if (f_trial <= 0) {
+    elastic_b = b_trial;  // elastic step: b^e_{n+1} = b^e_tr
+  } else {
+    const Real dgamma = f_trial / (2.0 * G + 2.0 / 3.0 * H + 2.0 / 3.0 * k);  // (3.83)
+    const Mat3 n = eta / eta_norm;  // radial return direction (3.79)
+    // eps_e = eps_tr - dgamma n (Table 3.4 residual, row 1), so tau = tau_tr - 2G dgamma n
+    // (n is deviatoric: the volumetric part is unchanged).
+    tau_hat -= 2.0 * G * dgamma * n;
+    beta += 2.0 / 3.0 * H * dgamma * (Q * n * Q.transpose());  // (3.71), (3.73)
+    alpha += kSqrtTwoThirds * dgamma;  // (3.74) as corrected in spec §9 erratum 3
+    if (H > 0) {
+      const Mat3 eps_e = Mat3(eps.asDiagonal()) - dgamma * n;
+      elastic_b = ExpTwice(Q * eps_e * Q.transpose());  // b^e = exp(2 eps_e) (4.40)
+    } else {
+      // n is diagonal in the trial frame: b^e = sum exp(2 eps_i) m_i (Table 3.4, 5(c)).
+      const Vec3 eps_e = eps - dgamma * n.diagonal();
+      elastic_b = Q * Vec3((2.0 * eps_e).array().exp()).asDiagonal() * Q.transpose();
+    }
+  }
+  if (H > 0) StoreBackStress(beta, h);
+  stress = (Q * tau_hat * Q.transpose()) / J;  // sigma = tau / J (3.37)
+}
+
+Real J2YieldFunction(const J2Params& p, const Mat3& tau, const History& h) {
+  const Mat3 eta = Dev(tau) - J2BackStressOf(h);  // (3.70)
+  return eta.norm() - kSqrtTwoThirds * (p.yield_stress + p.isotropic_hardening * h[kJ2PlasticStrain]);
+}
+
+Mat3 J2ElasticBFromStress(const J2Params& p, const Mat3& tau) {
+  // Compliance D^e = 1/(9K) 1 x 1 + 1/(2G) I_dev (3.47).
+  const Mat3 eps = tau.trace() / (9.0 * p.bulk_modulus) * Mat3::Identity() +
+                   Dev(tau) / (2.0 * p.shear_modulus);
+  return ExpTwice(Sym(eps));
+}
+
+Real J2Energy(const J2Params& p, Real J, const Mat3& stress) {
+  const Mat3 tau = J * stress;  // (3.37)
+  const Real tr = tau.trace();
+  return tr * tr / (18.0 * p.bulk_modulus) + Dev(tau).squaredNorm() / (4.0 * p.shear_modulus);
+}
+
+}  // namespace surge

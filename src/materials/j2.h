@@ -1,0 +1,38 @@
+// J2 (von Mises) plasticity at finite strain with linear isotropic and linear (Prager) kinematic
+// hardening: Mast (2013) §3.5, eqs. (3.69)-(3.83), with the finite-deformation return of
+// Table 3.4 (spec seed-algorithms.md §2.1, §2.4; errata 2 and 3 of spec §9 applied).
+#pragma once
+#include "core/particles.h"
+#include "materials/material_params.h"
+
+namespace surge {
+
+// History slots (Particles::history) of a J2 particle:
+//   [kJ2PlasticStrain]           alpha_iso, equivalent plastic strain sum sqrt(2/3) dgamma [-]
+//   [kJ2BackStress + 0 .. + 5]   back stress beta = -kappa_kin (Kirchhoff, deviatoric) [Pa],
+//                                components xx yy zz xy yz xz
+inline constexpr int kJ2PlasticStrain = 0;
+inline constexpr int kJ2BackStress = 1;
+
+// One stress update. Reads the incremental deformation gradient f = I + dt L, J = det F_{n+1},
+// b^e_n and the history; writes b^e_{n+1}, the history and the Cauchy stress sigma_{n+1}.
+// Pre: det f > 0, b^e_n symmetric positive definite, parameters positive (k, H >= 0).
+void J2Update(const J2Params& params, const Mat3& f, Real J, Mat3& elastic_b, History& history,
+              Mat3& stress);
+
+// Yield function F = ||dev tau - beta|| - sqrt(2/3) (sigma_Y + k alpha_iso) [Pa] (3.69)-(3.72),
+// evaluated at the Kirchhoff stress tau = J sigma. F <= 0 on or inside the yield surface.
+Real J2YieldFunction(const J2Params& params, const Mat3& tau, const History& history);
+
+// Back stress beta [Pa] stored in `history`.
+Mat3 J2BackStressOf(const History& history);
+
+// Elastic b^e for a given Kirchhoff stress: eps_e = D^e : tau (3.47), b^e = exp(2 eps_e) (4.40).
+// Used for a prescribed (geostatic) initial stress at F = I, where tau = sigma.
+Mat3 J2ElasticBFromStress(const J2Params& params, const Mat3& tau);
+
+// Stored elastic energy per reference volume [J/m^3]: psi = K/2 (tr eps_e)^2 + G dev eps_e :
+// dev eps_e (3.45), written in tau = J sigma as (tr tau)^2 / (18 K) + |dev tau|^2 / (4 G).
+Real J2Energy(const J2Params& params, Real J, const Mat3& stress);
+
+}  // namespace surge

@@ -1,0 +1,288 @@
+// Material-point verification (spec §2.10; issue 3): prescribed velocity gradients drive one
+// particle through UpdateStress (materials/material_driver.h), with no grid.
+//  J2 (Mast 2013 §3.5): every plastic return lands on the yield surface (1e-8 relative); rigid
+//  rotations leave the invariants unchanged (1e-10); uniaxial tension follows the closed-form
+//  hardening curve; unloading is elastic until reverse yield (Bauschinger shift 2/3 H per (3.71)).
+//  Newtonian fluid (Mast 2013 (6.1)-(6.2)): pressure vs J, simple shear stress 2 mu d, Tait EOS.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "materials/j2.h"
+#include "materials/material_driver.h"
+#include "materials/newtonian_fluid.h"
+#include "materials/update_stress.h"
+
+namespace surge {
+namespace {
+
+// Aluminium-like parameters of the seed's Taylor bar (Table 7.1) with explicit hardening moduli.
+J2Params Aluminium(Real isotropic, Real kinematic) {
+  return J2Params{68.6e9, 23.3e9, 61e6, isotropic, kinematic};
+}
+Material J2Material(const J2Params& p) { return Material{"al", 2710.0, p}; }
+
+Real YoungsModulus(const J2Params& p) {
+  return 9 * p.bulk_modulus * p.shear_modulus / (3 * p.bulk_modulus + p.shear_modulus);
+}
+
+Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0]; }
+
+Real YieldRadius(const J2Params& p, const History& h) {
+  return std::sqrt(2.0 / 3.0) * (p.yield_stress + p.isotropic_hardening * h[kJ2PlasticStrain]);
+}
+
+// Stress invariants I1, J2 = 1/2 s:s, J3 = det s.
+Vec3 Invariants(const Mat3& sigma) {
+  const Mat3 s = Dev(sigma);
+  return Vec3(sigma.trace(), 0.5 * s.squaredNorm(), s.determinant());
+}
+
+// A random velocity gradient with entries in [-rate, rate] (fixed seed, STYLE H.9).
+Mat3 RandomL(std::mt19937_64& rng, Real rate) {
+  std::uniform_real_distribution<Real> u(-rate, rate);
+  Mat3 L;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) L(i, j) = u(rng);
+  return L;
+}
+
+class J2DriverTest : public ::testing::TestWithParam<std::array<Real, 2>> {};
+
+TEST_P(J2DriverTest, EveryPlasticStepEndsOnTheYieldSurface) {
+  const J2Params p = Aluminium(GetParam()[0], GetParam()[1]);
+  MaterialPoint pt = MakeMaterialPoint(J2Material(p));
+  std::mt19937_64 rng(42);
+  const Real dt = 1e-6, rate = 400;  // strain increments up to 4e-4, ~ 0.4 yield strains
+  int plastic_steps = 0;
+  Real worst = 0;
+  for (int step = 0; step < 3000; ++step) {
+    const Real alpha_before = pt.particles.history[0][kJ2PlasticStrain];
+    StepMaterialPoint(pt, RandomL(rng, rate) + (step % 600 < 300 ? 1 : -1) * rate *
+                                                    Vec3(1, -0.5, -0.5).asDiagonal().toDenseMatrix(),
+                      dt);
+    const History& h = pt.particles.history[0];
+    const Real f = J2YieldFunction(p, Tau(pt), h);
+    const Real radius = YieldRadius(p, h);
+    if (h[kJ2PlasticStrain] > alpha_before) {
+      ++plastic_steps;
+      worst = std::max(worst, std::abs(f) / radius);
+      ASSERT_LE(std::abs(f), 1e-8 * radius) << "step " << step;
+    } else {
+      ASSERT_LE(f, 1e-8 * radius) << "elastic step " << step << " outside the yield surface";
+    }
+  }
+  std::printf("J2 k=%g H=%g: %d plastic steps of 3000, max |F|/radius = %.2e, alpha = %.4f\n",
+              p.isotropic_hardening, p.kinematic_hardening, plastic_steps, worst,
+              pt.particles.history[0][kJ2PlasticStrain]);
+  EXPECT_GT(plastic_steps, 1000);
+}
+
+TEST_P(J2DriverTest, RigidRotationLeavesInvariantsUnchanged) {
+  const J2Params p = Aluminium(GetParam()[0], GetParam()[1]);
+  MaterialPoint pt = MakeMaterialPoint(J2Material(p));
+  std::mt19937_64 rng(7);
+  const Real dt = 1e-6;
+  for (int step = 0; step < 200; ++step) StepMaterialPoint(pt, RandomL(rng, 400), dt);
+  ASSERT_GT(pt.particles.history[0][kJ2PlasticStrain], 0) << "the point must be plastic";
+
+  std::uniform_real_distribution<Real> angle(-3.0, 3.0);
+  Real worst = 0;
+  for (int r = 0; r < 20; ++r) {
+    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 beta0 = J2BackStressOf(pt.particles.history[0]);
+    const Real alpha0 = pt.particles.history[0][kJ2PlasticStrain];
+    const Vec3 axis = Vec3(angle(rng), angle(rng), angle(rng)).normalized();
+    const Mat3 R = Eigen::AngleAxis<Real>(angle(rng), axis).toRotationMatrix();
+    StepMaterialPoint(pt, (R - Mat3::Identity()) / dt, dt);  // f = I + dt L = R exactly
+
+    const Real scale = sigma0.norm();
+    const Vec3 i0 = Invariants(sigma0), i1 = Invariants(pt.particles.stress[0]);
+    const Vec3 tol = 1e-10 * Vec3(scale, scale * scale, scale * scale * scale);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(i1[i], i0[i], tol[i]) << "invariant " << i;
+    EXPECT_LE((pt.particles.stress[0] - R * sigma0 * R.transpose()).norm(), 1e-10 * scale);
+    const Mat3 beta1 = J2BackStressOf(pt.particles.history[0]);
+    EXPECT_LE((beta1 - R * beta0 * R.transpose()).norm(), 1e-10 * scale);
+    EXPECT_NEAR(pt.particles.history[0][kJ2PlasticStrain], alpha0, 1e-12 * alpha0);
+    worst = std::max(worst, (pt.particles.stress[0] - R * sigma0 * R.transpose()).norm() / scale);
+  }
+  std::printf("J2 k=%g H=%g: rigid rotations, max |sigma - R sigma0 R^T| / |sigma0| = %.2e\n",
+              p.isotropic_hardening, p.kinematic_hardening, worst);
+}
+
+// Uniaxial stress by mixed control (spec §2.10, Alawaji et al. 1992): the axial stretch is
+// prescribed; the lateral rate L22 = L33 is iterated (secant) until sigma22 = 0.
+void UniaxialStep(MaterialPoint& pt, Real stretch_ratio, Real dt, Real stress_tol) {
+  const Real axial = (stretch_ratio - 1) / dt;  // f11 = 1 + dt L11 = stretch_ratio exactly
+  auto lateral_stress = [&](Real x, MaterialPoint& trial) {
+    trial = pt;
+    StepMaterialPoint(trial, Vec3(axial, x, x).asDiagonal().toDenseMatrix(), dt);
+    return trial.particles.stress[0](1, 1);
+  };
+  MaterialPoint trial;
+  Real x0 = -0.5 * axial, x1 = -0.3 * axial;
+  Real s0 = lateral_stress(x0, trial), s1 = lateral_stress(x1, trial);
+  for (int it = 0; it < 60 && std::abs(s1) > stress_tol && s1 != s0; ++it) {
+    const Real x2 = x1 - s1 * (x1 - x0) / (s1 - s0);
+    x0 = x1;
+    s0 = s1;
+    x1 = x2;
+    s1 = lateral_stress(x1, trial);
+  }
+  ASSERT_LE(std::abs(s1), stress_tol);
+  pt = trial;
+}
+
+// Closed form for uniaxial Kirchhoff stress at log strain eps with linear combined hardening:
+// tau = sigma_Y + (k + H) eps_p and eps = tau/E + eps_p (coaxial, fixed axes: log strains add).
+Real UniaxialTau(const J2Params& p, Real eps) {
+  const Real E = YoungsModulus(p), kh = p.isotropic_hardening + p.kinematic_hardening;
+  if (E * eps <= p.yield_stress) return E * eps;
+  return (p.yield_stress + kh * eps) / (1 + kh / E);
+}
+
+TEST_P(J2DriverTest, UniaxialTensionFollowsTheClosedFormCurve) {
+  const J2Params p = Aluminium(GetParam()[0], GetParam()[1]);
+  MaterialPoint pt = MakeMaterialPoint(J2Material(p));
+  const Real dt = 1e-6, tol = 1e-10 * p.yield_stress;
+  Real stretch = 1, worst = 0;
+  const int steps = 200;
+  for (int n = 0; n < steps; ++n) {
+    const Real next = std::exp(0.05 * (n + 1) / steps);  // to 5 % log strain
+    UniaxialStep(pt, next / stretch, dt, tol);
+    stretch = next;
+    const Real exact = UniaxialTau(p, std::log(stretch));
+    const Real tau = Tau(pt)(0, 0);
+    worst = std::max(worst, std::abs(tau - exact) / exact);
+    ASSERT_NEAR(tau, exact, 1e-8 * exact) << "log strain " << std::log(stretch);
+  }
+  std::printf("J2 k=%g H=%g: uniaxial tension to 5 %% log strain, tau = %.6e Pa, max rel. error "
+              "%.2e\n", p.isotropic_hardening, p.kinematic_hardening, Tau(pt)(0, 0), worst);
+
+  // Unloading is elastic (d tau = E d eps, alpha fixed) down to the reverse yield stress
+  // tau = 3/2 beta11 - (sigma_Y + k alpha) = H alpha - (sigma_Y + k alpha).
+  const Real alpha = pt.particles.history[0][kJ2PlasticStrain];
+  const Real E = YoungsModulus(p);
+  const Real tau_peak = Tau(pt)(0, 0), eps_peak = std::log(stretch);
+  const Real reverse = p.kinematic_hardening * alpha - (p.yield_stress + p.isotropic_hardening * alpha);
+  EXPECT_NEAR(alpha, eps_peak - tau_peak / E, 1e-8 * alpha);
+  const Real eps_end = eps_peak - 0.99 * (tau_peak - reverse) / E;
+  for (int n = 1; n <= 50; ++n) {
+    const Real next = std::exp(eps_peak + (eps_end - eps_peak) * n / 50);
+    UniaxialStep(pt, next / stretch, dt, tol);
+    stretch = next;
+    EXPECT_EQ(pt.particles.history[0][kJ2PlasticStrain], alpha) << "unloading step " << n;
+    EXPECT_NEAR(Tau(pt)(0, 0), tau_peak + E * (std::log(stretch) - eps_peak), 1e-8 * tau_peak);
+  }
+  // Past the reverse yield stress the point flows again, in compression, on the surface.
+  for (int n = 1; n <= 20; ++n) {
+    stretch *= std::exp(-0.01 * (tau_peak - reverse) / E);
+    UniaxialStep(pt, std::exp(-0.01 * (tau_peak - reverse) / E), dt, tol);
+  }
+  EXPECT_GT(pt.particles.history[0][kJ2PlasticStrain], alpha);
+  EXPECT_LE(std::abs(J2YieldFunction(p, Tau(pt), pt.particles.history[0])),
+            1e-8 * YieldRadius(p, pt.particles.history[0]));
+}
+
+std::string HardeningName(const ::testing::TestParamInfo<std::array<Real, 2>>& info) {
+  const bool iso = info.param[0] > 0;
+  const bool kin = info.param[1] > 0;
+  return iso && kin ? "Combined" : iso ? "Isotropic" : kin ? "Kinematic" : "Perfect";
+}
+
+INSTANTIATE_TEST_SUITE_P(Hardening, J2DriverTest,
+                         ::testing::Values(std::array<Real, 2>{0.0, 0.0},      // perfect plasticity
+                                           std::array<Real, 2>{2e9, 0.0},      // isotropic
+                                           std::array<Real, 2>{0.0, 1.5e9},    // kinematic
+                                           std::array<Real, 2>{2e9, 1.5e9}),   // combined
+                         HardeningName);
+
+TEST(J2DriverTest, GeostaticStressIsReproducedByTheElasticState) {
+  const J2Params p = Aluminium(0, 0);
+  Mat3 sigma0 = Mat3::Zero();
+  sigma0.diagonal() << -2e7, -2e7, -5e7;
+  MaterialPoint pt = MakeMaterialPoint(J2Material(p), sigma0);
+  StepMaterialPoint(pt, Mat3::Zero(), 1e-6);  // f = I: the stress must come back unchanged
+  EXPECT_LE((pt.particles.stress[0] - sigma0).norm(), 1e-12 * sigma0.norm());
+  EXPECT_EQ(pt.particles.history[0][kJ2PlasticStrain], 0);
+}
+
+// --- Newtonian fluid ---
+Material Water(EquationOfState eos, Real viscosity) {
+  NewtonianFluidParams p;
+  p.bulk_modulus = 2.0e9;  // seed §6.1: k = 2.0 GPa, rho0 = 997.5 kg/m^3, mu = 0.001 Pa s
+  p.viscosity = viscosity;
+  p.equation_of_state = eos;
+  p.tait_gamma = 7;
+  return Material{"water", 997.5, p};
+}
+
+TEST(NewtonianFluidDriverTest, PressureFollowsKLnJ) {
+  const Real mu = 1e-3, K = 2.0e9, dt = 1e-5;
+  MaterialPoint pt = MakeMaterialPoint(Water(EquationOfState::kLinear, mu));
+  Real worst = 0;
+  for (int n = 0; n < 400; ++n) {
+    const Real rate = n < 200 ? -10.0 : 12.0;  // compress to J ~ 0.94, then expand
+    const Mat3 L = rate * Mat3::Identity();
+    StepMaterialPoint(pt, L, dt);
+    const Real J = pt.particles.F[0].determinant();
+    const Mat3 sigma = pt.particles.stress[0];
+    const Real expected = K * std::log(J) / J;  // (6.1) with theta = ln J, rho = rho0 / J
+    worst = std::max(worst, std::abs(sigma.trace() / 3 - 2 * mu * rate - expected) / std::abs(expected));
+    ASSERT_NEAR(sigma.trace() / 3 - 2 * mu * rate, expected, 1e-12 * std::abs(expected));
+    // tau_m = J sigma_m = K ln J: the Hencky volumetric law.
+    EXPECT_NEAR(J * (sigma.trace() / 3 - 2 * mu * rate), K * std::log(J), 1e-12 * K * std::abs(std::log(J)));
+  }
+  std::printf("fluid (linear EOS): max rel. error of sigma_m vs K ln J / J = %.2e\n", worst);
+}
+
+TEST(NewtonianFluidDriverTest, SimpleShearStressIsTwoMuD) {
+  const Real mu = 0.5, gamma_dot = 40.0, dt = 1e-4;
+  MaterialPoint pt = MakeMaterialPoint(Water(EquationOfState::kLinear, mu));
+  Mat3 L = Mat3::Zero();
+  L(0, 1) = gamma_dot;
+  for (int n = 0; n < 100; ++n) {
+    StepMaterialPoint(pt, L, dt);
+    const Mat3& sigma = pt.particles.stress[0];
+    // f = I + dt L is unimodular: J = 1, no pressure; d12 = gamma_dot / 2.
+    EXPECT_NEAR(sigma(0, 1), 2 * mu * 0.5 * gamma_dot, 1e-12 * mu * gamma_dot);
+    EXPECT_NEAR(sigma(1, 0), sigma(0, 1), 0);
+    EXPECT_NEAR(sigma.diagonal().norm(), 0, 1e-3 * mu * gamma_dot);
+  }
+  std::printf("fluid simple shear: sigma12 = %.6f Pa (2 mu d12 = %.6f Pa)\n",
+              pt.particles.stress[0](0, 1), mu * gamma_dot);
+}
+
+TEST(NewtonianFluidDriverTest, TaitEquationOfState) {
+  const Real K = 2.0e9, gamma = 7, B = K / gamma, dt = 1e-5;
+  MaterialPoint pt = MakeMaterialPoint(Water(EquationOfState::kTait, 0));
+  Real work = 0, worst = 0;  // work = int sigma_m dJ (trapezoid) against the stored energy
+  Real J_prev = 1, sm_prev = 0;
+  for (int n = 0; n < 300; ++n) {
+    StepMaterialPoint(pt, -10.0 * Mat3::Identity(), dt);  // compress to J ~ 0.91
+    const Real J = pt.particles.F[0].determinant();
+    const Real sigma_m = pt.particles.stress[0].trace() / 3;
+    const Real p = B * (std::pow(1 / J, gamma) - 1);  // p = B [(rho/rho0)^gamma - 1]
+    worst = std::max(worst, std::abs(-sigma_m - p) / p);
+    ASSERT_NEAR(-sigma_m, p, 1e-12 * p);
+    work += 0.5 * (sigma_m + sm_prev) * (J - J_prev);
+    J_prev = J;
+    sm_prev = sigma_m;
+  }
+  const Real psi = StrainEnergyDensity(pt.model.materials[0], pt.particles.F[0],
+                                       pt.particles.stress[0], pt.particles.strain[0]);
+  std::printf("fluid (Tait): J = %.4f, p = %.4e Pa, max rel. error %.2e, energy %.6e vs work %.6e\n",
+              J_prev, -sm_prev, worst, psi, work);
+  EXPECT_NEAR(psi, work, 1e-5 * psi);
+  // The Tait law is stiffer than the linear one in compression and agrees to first order.
+  const NewtonianFluidParams& tait = std::get<NewtonianFluidParams>(pt.model.materials[0].params);
+  const Real small = 1 - 1e-6;
+  EXPECT_NEAR(FluidMeanStress(tait, small), K * std::log(small) / small, 1e-5 * K * 1e-6);
+}
+
+}  // namespace
+}  // namespace surge
