@@ -12,8 +12,10 @@ namespace surge {
 
 // Per-particle history scalars of the plastic models. The meaning of each slot is fixed per
 // material model, in the model's header (materials/j2.h) and in docs/materials.md; models
-// without history leave all slots at zero.
+// without history leave all slots at zero. Slot kPlasticStrainSlot is the equivalent plastic
+// strain [-] in every plastic model (results field `plastic_strain`).
 inline constexpr int kHistorySlots = 8;
+inline constexpr int kPlasticStrainSlot = 0;
 using History = std::array<Real, kHistorySlots>;
 
 // Design: material history lives in Particles (rather than in per-model SoA arrays) so that

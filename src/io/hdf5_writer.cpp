@@ -201,7 +201,7 @@ struct ResultsWriter::Impl {
   std::vector<XdmfSnapshot> written;
   // Per-snapshot scratch, kept between snapshots so that writing allocates only on growth.
   std::vector<double> position, velocity, stress;
-  std::vector<double> pressure, von_mises, strain_volumetric, strain_equivalent;
+  std::vector<double> pressure, von_mises, strain_volumetric, strain_equivalent, plastic_strain;
   bool closed = false;
 
   Impl() { energy_sets.fill(-1); }
@@ -355,6 +355,7 @@ void ResultsWriter::WriteSnapshot(const State& state) {
   I.von_mises.resize(n);
   I.strain_volumetric.resize(n);
   I.strain_equivalent.resize(n);
+  I.plastic_strain.resize(n);
   // Independent per particle, so the output does not depend on the thread count.
   ParallelFor(n, 4096, [&](size_t p) {
     for (int d = 0; d < 3; ++d) {
@@ -368,6 +369,7 @@ void ResultsWriter::WriteSnapshot(const State& state) {
     I.pressure[p] = -s.trace() / 3.0;                        // > 0 in compression
     I.von_mises[p] = std::sqrt(1.5 * Dev(s).squaredNorm());  // q = sqrt(3/2 s:s)
     StrainInvariants(P.F[p], I.strain_volumetric[p], I.strain_equivalent[p]);
+    I.plastic_strain[p] = P.history[p][kPlasticStrainSlot];  // 0 for elastic and fluid models
   });
 
   char name[16];
@@ -390,6 +392,7 @@ void ResultsWriter::WriteSnapshot(const State& state) {
     WriteArray(g.get(), "material", H5T_NATIVE_INT32, H5T_STD_I32LE, P.material.data(), n, 0, I.h5);
     WriteArray(g.get(), "body", H5T_NATIVE_INT32, H5T_STD_I32LE, P.body.data(), n, 0, I.h5);
     WriteArray(g.get(), "id", H5T_NATIVE_INT64, H5T_STD_I64LE, P.id.data(), n, 0, I.h5);
+    write_doubles("plastic_strain", I.plastic_strain, 0);
   }
   I.WriteEnergyRows();
   I.Commit();

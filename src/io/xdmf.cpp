@@ -75,6 +75,7 @@ void WriteXdmf(const std::string& xmf_path, const std::string& h5_name,
       Attribute(out, h5, s.group, "material", "Scalar", s.particles, 0, "Int", 4);
       Attribute(out, h5, s.group, "body", "Scalar", s.particles, 0, "Int", 4);
       Attribute(out, h5, s.group, "id", "Scalar", s.particles, 0, "Int", 8);
+      Attribute(out, h5, s.group, "plastic_strain", "Scalar", s.particles, 0);
       out << "    </Grid>\n";
     }
     out << "    </Grid>\n  </Domain>\n</Xdmf>\n";

@@ -11,7 +11,7 @@ namespace surge {
 //   [kJ2PlasticStrain]           alpha_iso, equivalent plastic strain sum sqrt(2/3) dgamma [-]
 //   [kJ2BackStress + 0 .. + 5]   back stress beta = -kappa_kin (Kirchhoff, deviatoric) [Pa],
 //                                components xx yy zz xy yz xz
-inline constexpr int kJ2PlasticStrain = 0;
+inline constexpr int kJ2PlasticStrain = kPlasticStrainSlot;
 inline constexpr int kJ2BackStress = 1;
 
 // One stress update. Reads the incremental deformation gradient f = I + dt L, J = det F_{n+1},

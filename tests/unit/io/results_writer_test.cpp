@@ -211,7 +211,7 @@ TEST_F(ResultsWriterTest, WritesLayoutValuesTimingAndXdmf) {
   EXPECT_EQ(Dims(f, s1 + "velocity"), (std::vector<hsize_t>{5, 3}));
   EXPECT_EQ(Dims(f, s1 + "stress"), (std::vector<hsize_t>{5, 6}));
   for (const char* scalar : {"pressure", "von_mises", "strain_volumetric", "strain_equivalent",
-                             "material", "body", "id"})
+                             "material", "body", "id", "plastic_strain"})
     EXPECT_EQ(Dims(f, s1 + scalar), (std::vector<hsize_t>{5})) << scalar;
 
   // Values.
@@ -231,6 +231,7 @@ TEST_F(ResultsWriterTest, WritesLayoutValuesTimingAndXdmf) {
   // Hencky eps = diag(ln 1.1, 0, 0), e = ln 1.1 (2/3, -1/3, -1/3): sqrt(2/3 e:e) = 2/3 ln 1.1.
   EXPECT_NEAR(ReadDoubles(f, s0 + "strain_equivalent")[0], 2.0 / 3.0 * std::log(1.1), 4 * kEps);
   EXPECT_EQ(ReadDoubles(f, s0 + "strain_equivalent")[1], 0.0);
+  EXPECT_EQ(ReadDoubles(f, s0 + "plastic_strain"), std::vector<double>(5, 0.0));
   EXPECT_EQ(Read<int32_t>(f, s1 + "body", H5T_NATIVE_INT32),
             (std::vector<int32_t>{0, 1, 0, 1, 0}));
   EXPECT_EQ(Read<int64_t>(f, s1 + "id", H5T_NATIVE_INT64),
