@@ -201,6 +201,40 @@ INSTANTIATE_TEST_SUITE_P(Hardening, J2DriverTest,
                                            std::array<Real, 2>{2e9, 1.5e9}),   // combined
                          HardeningName);
 
+// Stress power tau : d per reference volume, integrated with the trapezoid rule, against the
+// stored energy psi (energy stage): equal while elastic, dissipation W - psi >= 0 once plastic.
+TEST(J2DriverTest, StoredEnergyMatchesStressWorkAndDissipationIsPositive) {
+  const J2Params p = Aluminium(2e9, 1.5e9);
+  MaterialPoint pt = MakeMaterialPoint(J2Material(p));
+  std::mt19937_64 rng(3);
+  const Real dt = 1e-6, slow = 2.0, fast = 400.0;
+  Real work = 0, worst_elastic = 0, min_dissipation = 0, psi_max = 0;
+  for (int step = 0; step < 2000; ++step) {
+    const Mat3 L = RandomL(rng, step < 1000 ? slow : fast);  // small (elastic), then plastic
+    const Mat3 tau0 = Tau(pt);
+    StepMaterialPoint(pt, L, dt);
+    const Mat3 d = Sym(L);
+    work += 0.5 * ((tau0 + Tau(pt)).array() * d.array()).sum() * dt;
+    const Real psi = StrainEnergyDensity(pt.model.materials[0], pt.particles.F[0],
+                                         pt.particles.stress[0], pt.particles.strain[0]);
+    psi_max = std::max(psi_max, psi);  // errors relative to the largest energy so far
+    if (step < 1000) {
+      ASSERT_EQ(pt.particles.history[0][kJ2PlasticStrain], 0) << "the slow phase must be elastic";
+      worst_elastic = std::max(worst_elastic, std::abs(psi - work) / psi_max);
+    } else {
+      min_dissipation = std::min(min_dissipation, (work - psi) / psi_max);
+    }
+  }
+  std::printf("J2 energy: elastic |psi - W| / psi_max <= %.2e; plastic (W - psi) / psi_max >= %.2e; "
+              "final W - psi = %.4e J/m^3\n", worst_elastic, min_dissipation,
+              work - StrainEnergyDensity(pt.model.materials[0], pt.particles.F[0],
+                                         pt.particles.stress[0], pt.particles.strain[0]));
+  // f = I + dt L (2.18) is a first-order approximation of exp(dt L): the work differs from the
+  // exact stress work by O(dt |L|) relative, hence the tolerances 10 dt |L|.
+  EXPECT_LT(worst_elastic, 10 * dt * slow);
+  EXPECT_GE(min_dissipation, -10 * dt * fast);
+}
+
 TEST(J2DriverTest, GeostaticStressIsReproducedByTheElasticState) {
   const J2Params p = Aluminium(0, 0);
   Mat3 sigma0 = Mat3::Zero();
