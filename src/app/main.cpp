@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/run.h"
+#include "app/scene_warnings.h"
 #include "core/log.h"
 #include "grid/sparse_grid.h"
 #include "io/results_writer.h"
@@ -69,6 +70,7 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
               steps, m.time.end);
   std::printf("memory     about %.1f MB (particles %.1f MB, grid %.1f MB)\n",
               (particle_bytes + grid_bytes) / 1e6, particle_bytes / 1e6, grid_bytes / 1e6);
+  for (const std::string& w : SceneWarnings(scene)) std::printf("warning    %s\n", w.c_str());
   std::printf("scene OK\n");
   return kExitOk;
 }
@@ -144,9 +146,7 @@ int Main(int argc, char** argv) {
                        : progress == "plain"    ? ProgressMode::kPlain
                        : progress == "quiet"    ? ProgressMode::kQuiet
                                                 : ProgressMode::kAuto;
-    if (scene.model.shape == ShapeFunction::kLinear && scene.model.scheme == UpdateScheme::kUsl)
-      LogWarn("linear shape functions with update: usl suffer the cell-crossing instability; "
-              "consider grid.update: musl or a B-spline (docs/validation.md)");
+    for (const std::string& w : SceneWarnings(scene)) LogWarn(w);
     LogInfo("running " + scene.model.name + ": " + std::to_string(scene.state.particles.size()) +
             " particles, results in " + options.out_dir);
     const RunSummary summary = RunScene(scene, options);
