@@ -3,7 +3,8 @@
 // plastic models.
 #include "materials/j2.h"
 
-#include <Eigen/Eigenvalues>
+#include "materials/hencky.h"
+
 #include <Eigen/SVD>
 #include <cmath>
 
@@ -11,14 +12,6 @@ namespace surge {
 namespace {
 
 const Real kSqrtTwoThirds = std::sqrt(2.0 / 3.0);
-
-// exp(2 eps) of a symmetric tensor, through its spectral decomposition (Mast 2013 (4.40)).
-Mat3 ExpTwice(const Mat3& eps) {
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(eps);
-  const Mat3& Q = eig.eigenvectors();
-  const Vec3 e = (2.0 * eig.eigenvalues()).array().exp();
-  return Q * e.asDiagonal() * Q.transpose();
-}
 
 void StoreBackStress(const Mat3& beta, History& h) {
   h[kJ2BackStress + 0] = beta(0, 0);
@@ -54,16 +47,13 @@ void J2Update(const J2Params& p, const Mat3& f, Real J, Mat3& elastic_b, History
   const Real H = p.kinematic_hardening;
   const Real k = p.isotropic_hardening;
 
-  // Trial elastic left Cauchy-Green tensor b^e_tr = f b^e_n f^T (3.35).
-  const Mat3 b_trial = Sym(f * elastic_b * f.transpose());
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(b_trial);
-  const Mat3 Q = eig.eigenvectors();
-  // Principal Hencky strains eps_i = 1/2 ln b_i (3.34), spec §9 erratum 2.
-  const Vec3 eps = 0.5 * eig.eigenvalues().array().log();
-  const Real theta = eps.sum();
-  // Principal trial Kirchhoff stress tau_i = K tr(eps) + 2G (eps_i - tr(eps)/3) (Table 3.4, 4).
-  const Vec3 s_trial = 2.0 * G * (eps.array() - theta / 3.0).matrix();
-  Mat3 tau_hat = (s_trial.array() + K * theta).matrix().asDiagonal();
+  // Trial b^e_tr = f b^e_n f^T, its principal Hencky strains and Kirchhoff stresses
+  // (Table 3.4, steps 1-4).
+  const HenckyTrial t = HenckyTrialState(K, G, f, elastic_b);
+  const Mat3& Q = t.Q;
+  const Vec3& eps = t.eps;
+  const Vec3 s_trial = (t.tau.array() - t.tau.sum() / 3.0).matrix();
+  Mat3 tau_hat = t.tau.asDiagonal();
 
   Mat3 beta = Mat3::Zero();
   if (H > 0) {
@@ -81,7 +71,7 @@ void J2Update(const J2Params& p, const Mat3& f, Real J, Mat3& elastic_b, History
   const Real f_trial = eta_norm - kSqrtTwoThirds * (p.yield_stress + k * alpha);
 
   if (f_trial <= 0) {
-    elastic_b = b_trial;  // elastic step: b^e_{n+1} = b^e_tr
+    elastic_b = FromPrincipal(Q, (2.0 * eps).array().exp().matrix());  // b^e_{n+1} = b^e_tr
   } else {
     const Real dgamma = f_trial / (2.0 * G + 2.0 / 3.0 * H + 2.0 / 3.0 * k);  // (3.83)
     const Mat3 n = eta / eta_norm;  // radial return direction (3.79)
@@ -106,19 +96,6 @@ void J2Update(const J2Params& p, const Mat3& f, Real J, Mat3& elastic_b, History
 Real J2YieldFunction(const J2Params& p, const Mat3& tau, const History& h) {
   const Mat3 eta = Dev(tau) - J2BackStressOf(h);  // (3.70)
   return eta.norm() - kSqrtTwoThirds * (p.yield_stress + p.isotropic_hardening * h[kJ2PlasticStrain]);
-}
-
-Mat3 J2ElasticBFromStress(const J2Params& p, const Mat3& tau) {
-  // Compliance D^e = 1/(9K) 1 x 1 + 1/(2G) I_dev (3.47).
-  const Mat3 eps = tau.trace() / (9.0 * p.bulk_modulus) * Mat3::Identity() +
-                   Dev(tau) / (2.0 * p.shear_modulus);
-  return ExpTwice(Sym(eps));
-}
-
-Real J2Energy(const J2Params& p, Real J, const Mat3& stress) {
-  const Mat3 tau = J * stress;  // (3.37)
-  const Real tr = tau.trace();
-  return tr * tr / (18.0 * p.bulk_modulus) + Dev(tau).squaredNorm() / (4.0 * p.shear_modulus);
 }
 
 }  // namespace surge

@@ -20,19 +20,16 @@ inline constexpr int kJ2BackStress = 1;
 void J2Update(const J2Params& params, const Mat3& f, Real J, Mat3& elastic_b, History& history,
               Mat3& stress);
 
+inline void PlasticUpdate(const J2Params& params, const Mat3& f, Real J, Mat3& elastic_b,
+                          History& history, Mat3& stress) {
+  J2Update(params, f, J, elastic_b, history, stress);
+}
+
 // Yield function F = ||dev tau - beta|| - sqrt(2/3) (sigma_Y + k alpha_iso) [Pa] (3.69)-(3.72),
 // evaluated at the Kirchhoff stress tau = J sigma. F <= 0 on or inside the yield surface.
 Real J2YieldFunction(const J2Params& params, const Mat3& tau, const History& history);
 
 // Back stress beta [Pa] stored in `history`.
 Mat3 J2BackStressOf(const History& history);
-
-// Elastic b^e for a given Kirchhoff stress: eps_e = D^e : tau (3.47), b^e = exp(2 eps_e) (4.40).
-// Used for a prescribed (geostatic) initial stress at F = I, where tau = sigma.
-Mat3 J2ElasticBFromStress(const J2Params& params, const Mat3& tau);
-
-// Stored elastic energy per reference volume [J/m^3]: psi = K/2 (tr eps_e)^2 + G dev eps_e :
-// dev eps_e (3.45), written in tau = J sigma as (tr tau)^2 / (18 K) + |dev tau|^2 / (4 G).
-Real J2Energy(const J2Params& params, Real J, const Mat3& stress);
 
 }  // namespace surge

@@ -54,6 +54,13 @@ struct NewtonianFluidParams {
 using MaterialParams =
     std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams>;
 
+// Elastoplastic models: Hencky elasticity in Kirchhoff stress with b^e as the state (Table 3.4).
+// Their stress update is PlasticUpdate(params, f, J, b^e, history, sigma), found by overload.
+template <class P>
+inline constexpr bool kIsElastoplastic =
+    !std::is_same_v<P, LinearElasticParams> && !std::is_same_v<P, NeoHookeanParams> &&
+    !std::is_same_v<P, NewtonianFluidParams>;
+
 struct Material {
   std::string name;
   Real density = 0;  // reference density rho_0 [kg/m^3]

@@ -4,6 +4,7 @@
 #include <array>
 
 #include "core/parallel.h"
+#include "materials/hencky.h"
 #include "materials/j2.h"
 #include "materials/linear_elastic.h"
 #include "materials/neo_hookean.h"
@@ -46,14 +47,16 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        P.stress[p] = NeoHookeanStress(params, P.F[p]);
                      });
                    },
-                   [&](const J2Params& params) {
+                   [&](const auto& params) {
+                     // Elastoplastic models (Hencky elasticity, b^e, Table 3.4): each provides
+                     // PlasticUpdate(params, f, J, b^e, history, sigma) in its own header.
                      ParallelFor(count, 256, [&](size_t k) {
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
                        P.strain[p] += Sym(f - Mat3::Identity());
-                       J2Update(params, f, P.F[p].determinant(), P.elastic_b[p], P.history[p],
-                                P.stress[p]);
+                       PlasticUpdate(params, f, P.F[p].determinant(), P.elastic_b[p],
+                                     P.history[p], P.stress[p]);
                      });
                    },
                    [&](const NewtonianFluidParams& params) {
@@ -78,7 +81,10 @@ Real StrainEnergyDensity(const Material& material, const Mat3& F, const Mat3& st
                           return LinearElasticEnergy(stress, strain);
                         },
                         [&](const NeoHookeanParams& p) { return NeoHookeanEnergy(p, F); },
-                        [&](const J2Params& p) { return J2Energy(p, F.determinant(), stress); },
+                        [&](const auto& p) {  // elastoplastic: Hencky energy of b^e (3.45)
+                          return HenckyEnergy(p.bulk_modulus, p.shear_modulus, F.determinant(),
+                                              stress);
+                        },
                         [&](const NewtonianFluidParams& p) {
                           return NewtonianFluidEnergy(p, F.determinant());
                         },
@@ -90,9 +96,18 @@ void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_
                     History& history) {
   history = History{};
   elastic_b = Mat3::Identity();
-  if (const auto* j2 = std::get_if<J2Params>(&material.params)) {
-    elastic_b = J2ElasticBFromStress(*j2, stress);  // at F = I, tau = sigma
-  }
+  std::visit(
+      [&](const auto& p) {
+        using P = std::decay_t<decltype(p)>;
+        if constexpr (kIsElastoplastic<P>) {
+          // At F = I, tau = sigma: b^e from the elastic compliance (3.47), (4.40).
+          elastic_b = ElasticBFromStress(p.bulk_modulus, p.shear_modulus, stress);
+          if constexpr (requires { InitialPlasticHistory(p, stress, history); }) {
+            InitialPlasticHistory(p, stress, history);
+          }
+        }
+      },
+      material.params);
 }
 
 Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,

@@ -17,32 +17,6 @@
 namespace surge {
 namespace {
 
-MaterialParams MakeLinearElastic(const MaterialSpec& m) {
-  return LinearElasticParams{m.bulk_modulus, m.shear_modulus};
-}
-MaterialParams MakeNeoHookean(const MaterialSpec& m) {
-  return NeoHookeanParams{m.bulk_modulus, m.shear_modulus};
-}
-MaterialParams MakeJ2(const MaterialSpec& m) {
-  return J2Params{m.bulk_modulus, m.shear_modulus, m.yield_stress, m.isotropic_hardening,
-                  m.kinematic_hardening};
-}
-MaterialParams MakeNewtonianFluid(const MaterialSpec& m) {
-  return NewtonianFluidParams{m.bulk_modulus, m.viscosity, m.equation_of_state, m.tait_gamma};
-}
-
-// The one table of material kinds. A new model adds a MaterialModel value, a params struct in
-// materials/material_params.h and a row here. Geostatic initial stress is refused for
-// hyperelastic models and fluids: their stress is a function of F (and L), and F starts at I.
-// j2 accepts it: its stress is a function of the elastic b^e, which InitialHistory sets from
-// the prescribed stress.
-constexpr MaterialKind kMaterialKinds[] = {
-    {"linear_elastic", MaterialModel::kLinearElastic, true, &MakeLinearElastic},
-    {"neo_hookean", MaterialModel::kNeoHookean, false, &MakeNeoHookean},
-    {"j2", MaterialModel::kJ2, true, &MakeJ2},
-    {"newtonian_fluid", MaterialModel::kNewtonianFluid, false, &MakeNewtonianFluid},
-};
-
 // Total particles allowed in one scene, and lattice candidates scanned for one body.
 constexpr double kMaxParticles = 2e8;
 constexpr double kMaxCandidates = 4e8;
@@ -170,15 +144,6 @@ SeededBody SeedBody(const SceneSpec& spec, size_t b) {
 }
 
 }  // namespace
-
-std::span<const MaterialKind> MaterialKinds() { return kMaterialKinds; }
-
-const MaterialKind& FindMaterialKind(MaterialModel model) {
-  for (const MaterialKind& k : kMaterialKinds) {
-    if (k.model == model) return k;
-  }
-  return kMaterialKinds[0];  // unreachable: every MaterialModel has a row
-}
 
 void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   model = Model{};

@@ -45,8 +45,6 @@ constexpr EnumName<UpdateScheme> kUpdateNames[] = {{"usl", UpdateScheme::kUsl},
                                                    {"musl", UpdateScheme::kMusl}};
 constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
-constexpr EnumName<EquationOfState> kEosNames[] = {{"linear", EquationOfState::kLinear},
-                                                   {"tait", EquationOfState::kTait}};
 constexpr EnumName<WallKind> kWallNames[] = {{"open", WallKind::kOpen},
                                              {"slip", WallKind::kSlip},
                                              {"no_slip", WallKind::kNoSlip},
@@ -303,6 +301,7 @@ class Parser {
 
   Wall ParseWall(const YAML::Node& n, const std::string& path) const;
   MaterialSpec ParseMaterial(const YAML::Node& n, const std::string& path) const;
+  void ParseElasticPair(const YAML::Node& n, const std::string& path, MaterialSpec& m) const;
   RegionShape ParseRegion(const YAML::Node& n, const std::string& path) const;
   BodySpec ParseBody(const YAML::Node& n, const std::string& path, const SceneSpec& spec) const;
 
@@ -346,21 +345,15 @@ Wall Parser::ParseWall(const YAML::Node& n, const std::string& path) const {
   return wall;
 }
 
-// Keys each material model accepts (the elastic pair is either (K, G) or (E, nu)).
-std::vector<std::string> MaterialKeys(MaterialModel model) {
-  const std::vector<std::string> elastic = {"model",        "density",      "youngs_modulus",
-                                            "poisson_ratio", "bulk_modulus", "shear_modulus"};
-  switch (model) {
-    case MaterialModel::kJ2: {
-      std::vector<std::string> keys = elastic;
-      keys.insert(keys.end(), {"yield_stress", "isotropic_hardening", "kinematic_hardening"});
-      return keys;
-    }
-    case MaterialModel::kNewtonianFluid:
-      return {"model", "density", "bulk_modulus", "viscosity", "equation_of_state", "tait_gamma"};
-    default:
-      return elastic;
+// Keys a material of `kind` accepts: model, density, the elastic pair (either (K, G) or (E, nu))
+// when the kind is elastic, and the kind's own keys.
+std::vector<std::string> MaterialKeys(const MaterialKind& kind) {
+  std::vector<std::string> keys = {"model", "density"};
+  if (kind.elastic) {
+    keys.insert(keys.end(), {"youngs_modulus", "poisson_ratio", "bulk_modulus", "shear_modulus"});
   }
+  for (const ParamDesc& d : kind.params) keys.push_back(d.key);
+  return keys;
 }
 
 MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path) const {
@@ -382,26 +375,37 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
     Fail(model, Child(path, "model"),
          "unknown material model '" + model.Scalar() + "' (expected one of: " + Join(names) + ")");
   }
-  ExpectMap(n, path, MaterialKeys(m.model));
+  const MaterialKind& kind = FindMaterialKind(m.model);
+  ExpectMap(n, path, MaterialKeys(kind));
   m.density = Positive(Need(n, path, "density"), Child(path, "density"), "kg/m^3");
-
-  if (m.model == MaterialModel::kNewtonianFluid) {
-    m.bulk_modulus = Positive(Need(n, path, "bulk_modulus"), Child(path, "bulk_modulus"), "Pa");
-    m.viscosity = NonNegative(Need(n, path, "viscosity"), Child(path, "viscosity"), "Pa s");
-    if (n["equation_of_state"]) {
-      m.equation_of_state =
-          Enum(n["equation_of_state"], Child(path, "equation_of_state"), kEosNames);
+  if (kind.elastic) ParseElasticPair(n, path, m);
+  for (const ParamDesc& d : kind.params) {
+    const YAML::Node v = d.required ? Need(n, path, d.key) : n[d.key];
+    if (!v) continue;
+    const std::string vp = Child(path, d.key);
+    if (d.choices.empty()) {
+      m.values[d.key] = Ranged(v, vp, d.unit, d.min, !d.min_open, d.max, !d.max_open);
+      continue;
     }
-    if (n["tait_gamma"]) {
-      if (m.equation_of_state != EquationOfState::kTait) {
-        Fail(n["tait_gamma"], Child(path, "tait_gamma"),
-             "tait_gamma applies only with equation_of_state: tait");
-      }
-      m.tait_gamma = Ranged(n["tait_gamma"], Child(path, "tait_gamma"), "-", 1, false, kInf, false);
+    std::vector<std::string> choices(d.choices.begin(), d.choices.end());
+    const auto it = v.IsScalar() ? std::find(choices.begin(), choices.end(), v.Scalar())
+                                 : choices.end();
+    if (!v.IsScalar()) Fail(v, vp, "expected one of: " + Join(choices) + ", got " + Describe(v));
+    if (it == choices.end()) {
+      Fail(v, vp, "unknown value '" + v.Scalar() + "' (expected one of: " + Join(choices) + ")");
     }
-    return m;
+    m.values[d.key] = static_cast<Real>(it - choices.begin());
   }
+  if (kind.check) {
+    if (const std::optional<ParamError> e = kind.check(m)) {
+      const YAML::Node at = n[e->key];
+      Fail(at ? at : n, at ? Child(path, e->key) : path, e->message);
+    }
+  }
+  return m;
+}
 
+void Parser::ParseElasticPair(const YAML::Node& n, const std::string& path, MaterialSpec& m) const {
   const bool kg = n["bulk_modulus"] || n["shear_modulus"];
   const bool enu = n["youngs_modulus"] || n["poisson_ratio"];
   if (kg && enu) {
@@ -427,18 +431,6 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
     m.bulk_modulus = m.youngs_modulus / (3.0 * (1.0 - 2.0 * m.poisson_ratio));
     m.shear_modulus = m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio));
   }
-  if (m.model == MaterialModel::kJ2) {
-    m.yield_stress = Positive(Need(n, path, "yield_stress"), Child(path, "yield_stress"), "Pa");
-    if (n["isotropic_hardening"]) {
-      m.isotropic_hardening =
-          NonNegative(n["isotropic_hardening"], Child(path, "isotropic_hardening"), "Pa");
-    }
-    if (n["kinematic_hardening"]) {
-      m.kinematic_hardening =
-          NonNegative(n["kinematic_hardening"], Child(path, "kinematic_hardening"), "Pa");
-    }
-  }
-  return m;
 }
 
 // Is the closed polyline simple (no two non-adjacent edges touch)? O(n^2), n is small.
@@ -897,28 +889,23 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     e << YAML::Key << m.name << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "model" << YAML::Value << FindMaterialKind(m.model).name;
     e << YAML::Key << "density" << YAML::Value << Num(m.density);
-    if (m.model == MaterialModel::kNewtonianFluid) {
-      e << YAML::Key << "bulk_modulus" << YAML::Value << Num(m.bulk_modulus);
-      e << YAML::Key << "viscosity" << YAML::Value << Num(m.viscosity);
-      e << YAML::Key << "equation_of_state" << YAML::Value
-        << NameOf(kEosNames, m.equation_of_state);
-      if (m.equation_of_state == EquationOfState::kTait) {
-        e << YAML::Key << "tait_gamma" << YAML::Value << Num(m.tait_gamma);
-      }
-      e << YAML::EndMap;
-      continue;
-    }
-    if (m.given_as_youngs) {
+    const MaterialKind& kind = FindMaterialKind(m.model);
+    if (kind.elastic && m.given_as_youngs) {
       e << YAML::Key << "youngs_modulus" << YAML::Value << Num(m.youngs_modulus);
       e << YAML::Key << "poisson_ratio" << YAML::Value << Num(m.poisson_ratio);
-    } else {
+    } else if (kind.elastic) {
       e << YAML::Key << "bulk_modulus" << YAML::Value << Num(m.bulk_modulus);
       e << YAML::Key << "shear_modulus" << YAML::Value << Num(m.shear_modulus);
     }
-    if (m.model == MaterialModel::kJ2) {
-      e << YAML::Key << "yield_stress" << YAML::Value << Num(m.yield_stress);
-      e << YAML::Key << "isotropic_hardening" << YAML::Value << Num(m.isotropic_hardening);
-      e << YAML::Key << "kinematic_hardening" << YAML::Value << Num(m.kinematic_hardening);
+    for (const ParamDesc& d : kind.params) {
+      const auto it = m.values.find(d.key);
+      if (it == m.values.end()) continue;
+      e << YAML::Key << d.key << YAML::Value;
+      if (d.choices.empty()) {
+        e << Num(it->second);
+      } else {
+        e << d.choices[static_cast<size_t>(it->second)];
+      }
     }
     e << YAML::EndMap;
   }

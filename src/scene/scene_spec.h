@@ -4,9 +4,13 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -47,36 +51,60 @@ struct DomainSpec {
 };
 
 // Material models known to the scene file; names and constructors live in the one table in
-// scene_builder.cpp (MaterialKinds()).
+// material_kinds.cpp (MaterialKinds()).
 enum class MaterialModel { kLinearElastic, kNeoHookean, kJ2, kNewtonianFluid };
 
 struct MaterialSpec {
   std::string name;  // the key under `materials`
   MaterialModel model = MaterialModel::kLinearElastic;
   Real density = 0;  // [kg/m^3]
-  // Elasticity is given either as (K, G) or as (E, nu); the parser fills K and G in both cases.
+  // Elasticity of the models whose kind has `elastic` set is given either as (K, G) or as
+  // (E, nu); the parser fills K and G in both cases.
   bool given_as_youngs = false;
   Real bulk_modulus = 0;   // K [Pa]
   Real shear_modulus = 0;  // G [Pa]
   Real youngs_modulus = 0; // E [Pa] (given_as_youngs only)
   Real poisson_ratio = 0;  // nu [-] (given_as_youngs only)
-  // j2 (Mast 2013 §3.5):
-  Real yield_stress = 0;         // sigma_Y, required, > 0 [Pa]
-  Real isotropic_hardening = 0;  // k, >= 0 [Pa]
-  Real kinematic_hardening = 0;  // H, >= 0 [Pa]
-  // newtonian_fluid (Mast 2013 §6.1); bulk_modulus above is required, shear_modulus unused:
-  Real viscosity = 0;  // dynamic viscosity mu, >= 0 [Pa s]
-  EquationOfState equation_of_state = EquationOfState::kLinear;
-  Real tait_gamma = 7;  // > 1 [-] (tait only)
+  // The model's own keys (MaterialKind::params) as written in the file; an enumerated key holds
+  // the index of its choice. Keys not written take their default through Param().
+  std::map<std::string, Real, std::less<>> values;
   SourceLoc loc;
+
+  // Value of a model key: as written, else the kind's default. Pre: `key` is one of the kind's.
+  Real Param(std::string_view key) const;
 };
 
-// Kinds of material model: one table (scene_builder.cpp) used by parser, writer and builder.
+// One model-specific key of a material (docs/scene-reference.md): a number in a range, or (when
+// `choices` is non-empty) one of a list of names, stored as its index.
+struct ParamDesc {
+  const char* key;
+  const char* unit;  // shown in messages: "Pa", "deg", "-", ...
+  Real min = 0;
+  bool min_open = false;  // min itself is not allowed
+  Real max = std::numeric_limits<Real>::infinity();
+  bool max_open = false;
+  bool required = false;
+  Real default_value = 0;  // when not required and not written
+  std::span<const char* const> choices = {};
+};
+
+// A cross-key rule a kind's `check` found broken: the key to point at, and why.
+struct ParamError {
+  std::string key;
+  std::string message;
+};
+
+// Kinds of material model: one table (material_kinds.cpp) used by parser, writer and builder.
+// A new model adds a MaterialModel value, a params struct in materials/material_params.h and a
+// row in that table.
 struct MaterialKind {
   const char* name;  // value of `model:` in the scene file
   MaterialModel model;
   bool allows_geostatic;  // the initial stress can be prescribed (not derived from F)
+  bool elastic;           // takes the elastic pair (K, G) or (E, nu)
+  std::span<const ParamDesc> params;
   MaterialParams (*make_params)(const MaterialSpec&);
+  std::optional<ParamError> (*check)(const MaterialSpec&) = nullptr;  // cross-key rules
 };
 std::span<const MaterialKind> MaterialKinds();
 const MaterialKind& FindMaterialKind(MaterialModel model);

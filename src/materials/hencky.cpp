@@ -1,0 +1,53 @@
+// Hencky elasticity and the principal-space return skeleton (Mast 2013 Table 3.4).
+#include "materials/hencky.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+namespace surge {
+
+HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_b) {
+  const Mat3 b_trial = Sym(f * elastic_b * f.transpose());  // (3.35)
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(b_trial);
+  HenckyTrial t;
+  t.Q = eig.eigenvectors();
+  t.eps = 0.5 * eig.eigenvalues().array().log();  // (3.34), erratum 2
+  t.tau = HenckyStress(K, G, t.eps);
+  return t;
+}
+
+Vec3 HenckyStress(Real K, Real G, const Vec3& eps) {
+  const Real theta = eps.sum();
+  return (2.0 * G * (eps.array() - theta / 3.0) + K * theta).matrix();  // [C^e_d] eps
+}
+
+Vec3 HenckyStrain(Real K, Real G, const Vec3& tau) {
+  const Real tr = tau.sum();
+  return (tr / (9.0 * K) + (tau.array() - tr / 3.0) / (2.0 * G)).matrix();  // [D^e_d] tau
+}
+
+void HenckyFinish(const HenckyTrial& t, Real K, Real G, const Vec3& tau, Real J,
+                  Mat3& elastic_b, Mat3& stress) {
+  const Vec3 eps_e = HenckyStrain(K, G, tau);
+  elastic_b = FromPrincipal(t.Q, (2.0 * eps_e).array().exp().matrix());  // Table 3.4, 5(c)
+  stress = FromPrincipal(t.Q, tau) / J;                                   // 5(d), (3.37)
+}
+
+Mat3 ExpTwice(const Mat3& eps) {
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(eps);
+  return FromPrincipal(eig.eigenvectors(), (2.0 * eig.eigenvalues()).array().exp().matrix());
+}
+
+Mat3 ElasticBFromStress(Real K, Real G, const Mat3& tau) {
+  // Compliance D^e = 1/(9K) 1 x 1 + 1/(2G) I_dev (3.47).
+  const Mat3 eps = tau.trace() / (9.0 * K) * Mat3::Identity() + Dev(tau) / (2.0 * G);
+  return ExpTwice(Sym(eps));
+}
+
+Real HenckyEnergy(Real K, Real G, Real J, const Mat3& stress) {
+  const Mat3 tau = J * stress;  // (3.37)
+  const Real tr = tau.trace();
+  return tr * tr / (18.0 * K) + Dev(tau).squaredNorm() / (4.0 * G);  // (3.45)
+}
+
+}  // namespace surge

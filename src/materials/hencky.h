@@ -1,0 +1,53 @@
+// Shared pieces of every elastoplastic model in Surge: quadratic-logarithmic (Hencky) elasticity
+// in Kirchhoff stress and the principal-space finite-deformation return of Mast (2013) Table 3.4
+// (spec seed-algorithms.md §2.0-§2.1; errata 1 and 2 of spec §9 applied).
+//
+// A model's stress update is
+//   HenckyTrial t = HenckyTrialState(K, G, f, b^e_n);       // Table 3.4 steps 1-4
+//   Vec3 tau = <the model's return of t.tau in principal space>;
+//   HenckyFinish(t, K, G, tau, J, b^e, sigma);               // steps 5(c), 5(d), (3.37)
+// so every model shares the spectral decomposition and the bookkeeping of b^e.
+#pragma once
+#include "core/math.h"
+
+namespace surge {
+
+// Trial state in the eigenbasis of b^e_tr = f b^e_n f^T (3.35).
+struct HenckyTrial {
+  Mat3 Q;    // eigenvectors of b^e_tr (columns): the principal directions n^(i)
+  Vec3 eps;  // principal trial Hencky strains eps_i = 1/2 ln b_i (3.34), erratum 2
+  Vec3 tau;  // principal trial Kirchhoff stresses [C^e_d] eps (Table 3.4, step 4) [Pa]
+};
+
+// Steps 1-4 of Table 3.4. Pre: det f > 0, b^e_n symmetric positive definite.
+HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_b);
+
+// Principal Kirchhoff stress of principal Hencky strains: tau_i = K tr(eps) + 2G (eps_i - tr/3)
+// ([C^e_d], spec §2.0, with the factor 2 of erratum 1).
+Vec3 HenckyStress(Real K, Real G, const Vec3& eps);
+
+// Inverse: eps_i = tr(tau)/(9K) + (tau_i - tr(tau)/3)/(2G) ([D^e_d], compliance (3.47)).
+Vec3 HenckyStrain(Real K, Real G, const Vec3& tau);
+
+// Steps 5(c)-(d) of Table 3.4 and (3.37): b^e_{n+1} = sum exp(2 eps^e_i) m^(i) with
+// eps^e = [D^e_d] tau, and sigma_{n+1} = (sum tau_i m^(i)) / J.
+void HenckyFinish(const HenckyTrial& trial, Real K, Real G, const Vec3& tau, Real J,
+                  Mat3& elastic_b, Mat3& stress);
+
+// Elastic b^e for a Kirchhoff stress: eps_e = D^e : tau (3.47), b^e = exp(2 eps_e) (4.40).
+// Used for a prescribed (geostatic) initial stress at F = I, where tau = sigma.
+Mat3 ElasticBFromStress(Real K, Real G, const Mat3& tau);
+
+// Stored energy per reference volume [J/m^3]: psi = K/2 (tr eps_e)^2 + G dev eps_e : dev eps_e
+// (3.45), written in tau = J sigma as (tr tau)^2 / (18 K) + |dev tau|^2 / (4 G).
+Real HenckyEnergy(Real K, Real G, Real J, const Mat3& stress);
+
+// exp(2 eps) of a symmetric tensor through its spectral decomposition (Mast 2013 (4.40)).
+Mat3 ExpTwice(const Mat3& eps);
+
+// Principal values -> tensor in the trial frame: Q diag(v) Q^T.
+inline Mat3 FromPrincipal(const Mat3& Q, const Vec3& v) {
+  return Q * v.asDiagonal() * Q.transpose();
+}
+
+}  // namespace surge

@@ -1,0 +1,89 @@
+// The one table of material kinds (STYLE H.4): scene name, the model's keys with their units,
+// ranges and defaults, and the constructor of its parameter struct. The parser, the writer and
+// the builder all read this table, so a new model adds a MaterialModel value, a params struct in
+// materials/material_params.h and one row here (docs/scene-reference.md lists the keys).
+#include <stdexcept>
+#include <string>
+
+#include "scene/scene_spec.h"
+
+namespace surge {
+namespace {
+
+constexpr Real kInf = std::numeric_limits<Real>::infinity();
+
+// --- linear_elastic, neo_hookean: the elastic pair only ---------------------------------------
+
+MaterialParams MakeLinearElastic(const MaterialSpec& m) {
+  return LinearElasticParams{m.bulk_modulus, m.shear_modulus};
+}
+MaterialParams MakeNeoHookean(const MaterialSpec& m) {
+  return NeoHookeanParams{m.bulk_modulus, m.shear_modulus};
+}
+
+// --- j2 (Mast 2013 §3.5) ----------------------------------------------------------------------
+
+constexpr ParamDesc kJ2Keys[] = {
+    {"yield_stress", "Pa", 0, true, kInf, false, true},  // sigma_Y > 0
+    {"isotropic_hardening", "Pa"},                       // k >= 0
+    {"kinematic_hardening", "Pa"},                       // H >= 0
+};
+MaterialParams MakeJ2(const MaterialSpec& m) {
+  return J2Params{m.bulk_modulus, m.shear_modulus, m.Param("yield_stress"),
+                  m.Param("isotropic_hardening"), m.Param("kinematic_hardening")};
+}
+
+// --- newtonian_fluid (Mast 2013 §6.1) ---------------------------------------------------------
+
+constexpr const char* kEosChoices[] = {"linear", "tait"};  // EquationOfState order
+constexpr ParamDesc kFluidKeys[] = {
+    {"bulk_modulus", "Pa", 0, true, kInf, false, true},  // K > 0
+    {"viscosity", "Pa s", 0, false, kInf, false, true},  // mu >= 0
+    {"equation_of_state", "", 0, false, kInf, false, false, 0, kEosChoices},
+    {"tait_gamma", "-", 1, true, kInf, false, false, 7},  // gamma > 1
+};
+MaterialParams MakeNewtonianFluid(const MaterialSpec& m) {
+  return NewtonianFluidParams{m.Param("bulk_modulus"), m.Param("viscosity"),
+                              static_cast<EquationOfState>(m.Param("equation_of_state")),
+                              m.Param("tait_gamma")};
+}
+std::optional<ParamError> CheckNewtonianFluid(const MaterialSpec& m) {
+  if (m.values.count("tait_gamma") &&
+      static_cast<EquationOfState>(m.Param("equation_of_state")) != EquationOfState::kTait) {
+    return ParamError{"tait_gamma", "tait_gamma applies only with equation_of_state: tait"};
+  }
+  return std::nullopt;
+}
+
+// Geostatic initial stress is refused for hyperelastic models and fluids: their stress is a
+// function of F (and L), and F starts at I. Elastoplastic models accept it: their stress is a
+// function of the elastic b^e, which InitialHistory sets from the prescribed stress.
+constexpr MaterialKind kMaterialKinds[] = {
+    {"linear_elastic", MaterialModel::kLinearElastic, true, true, {}, &MakeLinearElastic},
+    {"neo_hookean", MaterialModel::kNeoHookean, false, true, {}, &MakeNeoHookean},
+    {"j2", MaterialModel::kJ2, true, true, kJ2Keys, &MakeJ2},
+    {"newtonian_fluid", MaterialModel::kNewtonianFluid, false, false, kFluidKeys,
+     &MakeNewtonianFluid, &CheckNewtonianFluid},
+};
+
+}  // namespace
+
+std::span<const MaterialKind> MaterialKinds() { return kMaterialKinds; }
+
+const MaterialKind& FindMaterialKind(MaterialModel model) {
+  for (const MaterialKind& k : kMaterialKinds) {
+    if (k.model == model) return k;
+  }
+  return kMaterialKinds[0];  // unreachable: every MaterialModel has a row
+}
+
+Real MaterialSpec::Param(std::string_view key) const {
+  if (const auto it = values.find(key); it != values.end()) return it->second;
+  for (const ParamDesc& d : FindMaterialKind(model).params) {
+    if (key == d.key) return d.default_value;
+  }
+  throw std::logic_error("material model '" + std::string(FindMaterialKind(model).name) +
+                         "' has no key '" + std::string(key) + "'");  // a programming error
+}
+
+}  // namespace surge
