@@ -22,6 +22,7 @@ LoadedScene Load(std::string path, std::string text, const std::string& source,
   scene.path = std::move(path);
   scene.text = std::move(text);
   scene.resolved_yaml = SceneSpecToYaml(spec);
+  scene.parameters = spec.parameters;
   return scene;
 }
 

@@ -1,6 +1,7 @@
 // Public scene API: scene file (YAML, docs/scene-reference.md) -> Model + State.
 #pragma once
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/model.h"
@@ -13,6 +14,7 @@ struct LoadedScene {
   std::string path;           // file path, or "<string>" for LoadSceneFromString
   std::string text;           // the scene file verbatim
   std::string resolved_yaml;  // the parsed spec with every default filled in, as YAML
+  std::vector<std::pair<std::string, Real>> parameters;  // `parameters:` after --set
   Model model;
   State state;  // particles seeded, grouped by material (stable sort), groups filled
 };

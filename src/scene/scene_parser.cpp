@@ -13,6 +13,7 @@
 #include <set>
 
 #include "scene/scene_error.h"
+#include "scene/scene_expressions.h"
 #include "scene/scene_spec.h"
 
 namespace surge {
@@ -153,6 +154,107 @@ AppliedOverride ApplyOverride(YAML::Node root, const std::string& text) {
   }
   return {where, path};
 }
+
+// Where a node came from, for errors raised before the Parser exists: its file position, or the
+// --set override that wrote it.
+SourceLoc NodeLoc(const YAML::Node& n, const std::string& path, const std::string& source,
+                  const std::vector<AppliedOverride>& overrides) {
+  for (auto it = overrides.rbegin(); it != overrides.rend(); ++it) {
+    if (IsUnder(path, it->path)) return {it->text, 0, 0};
+  }
+  if (n.IsDefined() && n.Mark().line >= 0) return {source, n.Mark().line + 1, n.Mark().column + 1};
+  return {source, 0, 0};
+}
+
+// Scene arithmetic (docs/scene-reference.md, "Parameters and expressions"): reads `parameters:`
+// (a map of name -> number or ${expr} over earlier names), then replaces every scalar of the
+// form ${expr} elsewhere in the tree by its value. Runs after --set, before validation.
+class ExpressionResolver {
+ public:
+  ExpressionResolver(std::string source, const std::vector<AppliedOverride>& overrides)
+      : source_(std::move(source)), overrides_(overrides) {}
+
+  SceneParameters Resolve(YAML::Node root) {
+    if (!root.IsMap()) return {};
+    const YAML::Node params = root["parameters"];
+    if (params) ReadParameters(params);
+    for (auto kv : root) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+      if (key != "parameters") Substitute(kv.second, key);
+    }
+    return parameters_;
+  }
+
+ private:
+  [[noreturn]] void Fail(const YAML::Node& n, const std::string& path, const std::string& msg) const {
+    const SourceLoc loc = NodeLoc(n, path, source_, overrides_);
+    throw SceneError(loc.source, loc.line, loc.column, path, msg);
+  }
+
+  static bool IsExpression(const std::string& s) {
+    return s.size() >= 3 && s.compare(0, 2, "${") == 0 && s.back() == '}';
+  }
+
+  Real Evaluate(const YAML::Node& n, const std::string& path) const {
+    const std::string& text = n.Scalar();
+    Real value = 0;
+    std::string error;
+    if (!EvaluateSceneExpression(text.substr(2, text.size() - 3), parameters_, value, error)) {
+      std::string names;
+      for (const auto& p : parameters_) names += (names.empty() ? "" : ", ") + p.first;
+      Fail(n, path, "cannot evaluate '" + text + "': " + error +
+                        (names.empty() ? " (no parameters defined)" : " (parameters: " + names + ")"));
+    }
+    return value;
+  }
+
+  void ReadParameters(const YAML::Node& params) {
+    if (!params.IsMap()) {
+      Fail(params, "parameters", "expected a map of name -> number, got " + Describe(params));
+    }
+    for (const auto& kv : params) {
+      const std::string name = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+      const std::string path = Child("parameters", name);
+      const bool identifier =
+          !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_') &&
+          std::all_of(name.begin(), name.end(),
+                      [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+      if (!identifier) {
+        Fail(kv.first, path, "a parameter name must be letters, digits and '_', not starting with a digit");
+      }
+      for (const auto& p : parameters_) {
+        if (p.first == name) Fail(kv.first, path, "duplicate parameter '" + name + "'");
+      }
+      const YAML::Node v = kv.second;
+      Real value = 0;
+      if (v.IsScalar() && IsExpression(v.Scalar())) {
+        value = Evaluate(v, path);
+      } else {
+        if (!v.IsScalar() || !YAML::convert<Real>::decode(v, value) || !std::isfinite(value)) {
+          Fail(v, path, "expected a number or ${expression}, got " + Describe(v));
+        }
+      }
+      parameters_.emplace_back(name, value);
+    }
+  }
+
+  void Substitute(YAML::Node n, const std::string& path) {
+    if (n.IsScalar()) {
+      if (IsExpression(n.Scalar())) n = Num(Evaluate(n, path));
+    } else if (n.IsSequence()) {
+      for (size_t i = 0; i < n.size(); ++i) Substitute(n[i], Index(path, i));
+    } else if (n.IsMap()) {
+      for (auto kv : n) {
+        const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+        Substitute(kv.second, Child(path, key));
+      }
+    }
+  }
+
+  std::string source_;
+  const std::vector<AppliedOverride>& overrides_;
+  SceneParameters parameters_;
+};
 
 // Validating reader over a YAML node tree. Every accessor takes the node and its display path.
 class Parser {
@@ -641,7 +743,8 @@ BodySpec Parser::ParseBody(const YAML::Node& n, const std::string& path,
 SceneSpec Parser::Parse(const YAML::Node& root) {
   SceneSpec spec;
   const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
-                                        "grid",   "domain",    "materials", "bodies",  "output"};
+                                        "grid",   "domain",    "materials", "bodies",  "output",
+                                        "parameters"};
   if (!root.IsDefined() || root.IsNull()) {
     throw SceneError(source_, 0, 0, "", "the scene is empty (expected a map with keys " + Join(top) + ")");
   }
@@ -833,9 +936,12 @@ SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
     if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
     applied.push_back(ApplyOverride(root, o));
   }
+  SceneParameters parameters = ExpressionResolver(source, applied).Resolve(root);
   Parser parser(source, base_dir, applied);
   try {
-    return parser.Parse(root);
+    SceneSpec spec = parser.Parse(root);
+    spec.parameters = std::move(parameters);
+    return spec;
   } catch (const YAML::Exception& e) {  // defensive: the parser checks types before converting
     throw SceneError(source, e.mark.line + 1, e.mark.column + 1, "", e.what());
   }
@@ -947,6 +1053,11 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   e << YAML::Key << "vdb" << YAML::Value << spec.output.vdb;
   e << YAML::Key << "energy" << YAML::Value << spec.output.energy;
   e << YAML::EndMap;
+  if (!spec.parameters.empty()) {  // values already substituted; kept for the record
+    e << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
+    for (const auto& [name, value] : spec.parameters) e << YAML::Key << name << YAML::Value << Num(value);
+    e << YAML::EndMap;
+  }
   e << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
 }

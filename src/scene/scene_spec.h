@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -172,6 +173,9 @@ struct SceneSpec {
   std::vector<MaterialSpec> materials;  // in file order; Model::materials has the same order
   std::vector<BodySpec> bodies;
   OutputSpec output;
+  // `parameters:` in file order, after --set overrides; `${expr}` values were evaluated over
+  // them before validation (scene_expressions.h).
+  std::vector<std::pair<std::string, Real>> parameters;
 };
 
 // Parses scene text into a validated spec. `source` names the text in errors; `base_dir` resolves

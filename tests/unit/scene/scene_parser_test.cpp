@@ -557,5 +557,39 @@ TEST(SceneResolvedYamlTest, RereadsIn2D) {
   EXPECT_EQ(a.state.particles.ext_force, b.state.particles.ext_force);
 }
 
+
+// Scene arithmetic: `parameters:` and ${expr} values (docs/scene-reference.md).
+TEST(SceneParametersTest, ExpressionsUseParametersAndOverrides) {
+  const std::string text =
+      Replace(kBase2, "max: [1, 1]}}", "max: [\"${l0}\", \"${a * l0}\"]}}") +
+      "parameters: {a: 2, l0: 0.5, half: \"${l0 / 2}\"}\n";
+  const LoadedScene s = LoadSceneFromString(text, "p.yaml");
+  Real ymax = 0;
+  for (const Vec3& x : s.state.particles.x) ymax = std::max(ymax, x.y());
+  EXPECT_GT(ymax, 0.75);  // the box reaches y = a l0 = 1
+  EXPECT_LT(ymax, 1.0);
+  ASSERT_EQ(s.parameters.size(), 3u);
+  EXPECT_EQ(s.parameters[2].second, 0.25);
+  const LoadedScene tall = LoadSceneFromString(text, "p.yaml", {"parameters.a=3"});
+  EXPECT_GT(tall.state.particles.size(), s.state.particles.size());
+  const LoadedScene again = LoadSceneFromString(tall.resolved_yaml, "resolved.yaml");
+  EXPECT_EQ(again.resolved_yaml, tall.resolved_yaml);
+}
+
+TEST(SceneParametersTest, BadExpressionsNameLineAndKey) {
+  const std::string base = Replace(kBase2, "max: [1, 1]}}", "max: [1, \"${a * b}\"]}}");
+  ExpectError(base + "parameters: {a: 2}\n", 11, "bodies[0].region.box.max[1]",
+              "cannot evaluate '${a * b}'");
+  ExpectError(base + "parameters: {a: 2, 2b: 1}\n", 12, "parameters.2b", "parameter name");
+  ExpectError(base + "parameters: {a: 2, b: [1]}\n", 12, "parameters.b",
+              "expected a number or ${expression}");
+  ExpectError(base + "parameters: {a: 2, b: \"${c}\", c: 1}\n", 12, "parameters.b",
+              "cannot evaluate");
+  ExpectError(kBase2 + "parameters: [1, 2]\n", 12, "parameters", "expected a map");
+  const Caught c = Load(base + "parameters: {a: 2, b: 1}\n", {"parameters.b=x"});
+  EXPECT_TRUE(c.thrown);
+  EXPECT_EQ(c.file, "--set parameters.b=x");
+}
+
 }  // namespace
 }  // namespace surge
