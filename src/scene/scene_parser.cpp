@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <set>
 
 #include "scene/scene_error.h"
@@ -703,7 +704,6 @@ BodySpec Parser::ParseBody(const YAML::Node& n, const std::string& path,
     const YAML::Node geo = Need(is, ip, "geostatic");
     const std::string gp = Child(ip, "geostatic");
     ExpectMap(geo, gp, {"k0"});
-    b.geostatic_k0 = Positive(Need(geo, gp, "k0"), Child(gp, "k0"), "-");
     if (spec.gravity.norm() == 0) {
       Fail(geo, gp, "a geostatic initial stress needs a non-zero gravity");
     }
@@ -713,6 +713,19 @@ BodySpec Parser::ParseBody(const YAML::Node& n, const std::string& path,
       Fail(geo, gp,
            "a geostatic initial stress is not available for material '" + m.name + "' (model " +
                kind.name + ": its stress follows from the deformation gradient)");
+    }
+    const YAML::Node k0 = Need(geo, gp, "k0");
+    if (k0.IsScalar() && k0.Scalar() == "jaky") {
+      if (!kind.friction_angle_deg) {
+        Fail(k0, Child(gp, "k0"),
+             "k0: jaky needs a material with a friction angle; model " + std::string(kind.name) +
+                 " of material '" + m.name + "' has none (give k0 as a number)");
+      }
+      // Jaky (1944): K0 = 1 - sin(phi') for normally consolidated soil.
+      b.geostatic_k0 = 1.0 - std::sin(kind.friction_angle_deg(m) * std::numbers::pi / 180.0);
+      b.k0_from_friction = true;
+    } else {
+      b.geostatic_k0 = Positive(k0, Child(gp, "k0"), "- (or jaky)");
     }
   }
   if (n["tractions"]) {
@@ -1032,7 +1045,8 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     if (b.geostatic_k0) {
       e << YAML::Key << "initial_stress" << YAML::Value << YAML::Flow << YAML::BeginMap
         << YAML::Key << "geostatic" << YAML::Value << YAML::BeginMap << YAML::Key << "k0"
-        << YAML::Value << Num(*b.geostatic_k0) << YAML::EndMap << YAML::EndMap;
+        << YAML::Value << (b.k0_from_friction ? std::string("jaky") : Num(*b.geostatic_k0))
+        << YAML::EndMap << YAML::EndMap;
     }
     e << YAML::Key << "tractions" << YAML::Value;
     if (b.tractions.empty()) e << YAML::Flow;

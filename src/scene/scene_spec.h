@@ -106,6 +106,8 @@ struct MaterialKind {
   std::span<const ParamDesc> params;
   MaterialParams (*make_params)(const MaterialSpec&);
   std::optional<ParamError> (*check)(const MaterialSpec&) = nullptr;  // cross-key rules
+  // Friction angle [deg] used by `k0: jaky` (geostatic start); nullptr: the model has none.
+  Real (*friction_angle_deg)(const MaterialSpec&) = nullptr;
 };
 std::span<const MaterialKind> MaterialKinds();
 const MaterialKind& FindMaterialKind(MaterialModel model);
@@ -151,6 +153,7 @@ struct BodySpec {
   uint64_t seed = 1;           // jitter RNG seed
   Vec3 velocity = Vec3::Zero();  // [m/s]
   std::optional<Real> geostatic_k0;  // initial_stress: {geostatic: {k0}}
+  bool k0_from_friction = false;     // k0 was given as `jaky`: 1 - sin(phi) of the material
   std::vector<TractionSpec> tractions;
   SourceLoc loc;         // the body's map
   SourceLoc region_loc;  // the `region` map

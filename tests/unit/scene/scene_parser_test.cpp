@@ -357,6 +357,13 @@ TEST(SceneParserTest, GeostaticOnNeoHookean) {
   ExpectError(text, 12, "bodies[0].initial_stress.geostatic", "neo_hookean");
 }
 
+TEST(SceneParserTest, JakyK0NeedsAFrictionAngle) {
+  ExpectError(kBase3 + "    initial_stress: {geostatic: {k0: jaky}}\n" + "gravity: [0, -10, 0]\n",
+              12, "bodies[0].initial_stress.geostatic.k0", "k0: jaky needs a material with a friction angle");
+  ExpectError(kBase3 + "    initial_stress: {geostatic: {k0: 1-nu}}\n" + "gravity: [0, -10, 0]\n",
+              12, "bodies[0].initial_stress.geostatic.k0", "(or jaky)");
+}
+
 TEST(SceneParserTest, JitterOutOfRange) {
   ExpectError(kBase3 + "    jitter: 1.0\n", 12, "bodies[0].jitter", "must be in [0, 1) [-], got 1.0");
 }
