@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <tbb/version.h>
 
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -68,6 +69,13 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
               grid.block_count(), grid.ActiveNodeCount());
   std::printf("time step  %.4g s (CFL %.2f) -> about %.0f steps to t = %g s\n", dt, m.time.cfl,
               steps, m.time.end);
+  const Real dt_viscous = ViscousTimeStep(m, scene.state);
+  if (std::isfinite(dt_viscous)) {
+    std::printf("           viscous limit %.4g s (%s)\n", dt_viscous,
+                m.time.fixed_dt > 0           ? "not applied: time.fixed_dt"
+                : dt_viscous <= dt * 1.000001 ? "governs"
+                                              : "not binding");
+  }
   std::printf("memory     about %.1f MB (particles %.1f MB, grid %.1f MB)\n",
               (particle_bytes + grid_bytes) / 1e6, particle_bytes / 1e6, grid_bytes / 1e6);
   for (const std::string& w : SceneWarnings(scene)) std::printf("warning    %s\n", w.c_str());

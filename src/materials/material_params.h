@@ -51,15 +51,46 @@ struct NewtonianFluidParams {
   Real tait_gamma = 7;    // Tait exponent gamma [-] (kTait only)
 };
 
+// Regularised Bingham fluid (Anura3D manual §7.2.2, eq. (7.37) corrected, spec §A.16.3):
+// sigma = sigma_m(J) 1 + 2 mu_eff dev(d), mu_eff = min(mu_d + tau_y / ||D||, mu_max),
+// ||D|| = sqrt(2 d':d'); sigma_m(J) from the Newtonian fluid's EOS. materials/bingham_fluid.h.
+struct BinghamFluidParams {
+  Real bulk_modulus = 0;   // K = rho0 c0^2 [Pa]
+  Real viscosity = 0;      // mu_d, plastic (Bingham) viscosity above yield [Pa s]
+  Real yield_stress = 0;   // tau_y, shear yield stress [Pa]
+  Real max_viscosity = 0;  // mu_max, cap of mu_eff below the yield rate [Pa s]
+  EquationOfState equation_of_state = EquationOfState::kLinear;
+  Real tait_gamma = 7;     // Tait exponent gamma [-] (kTait only)
+};
+
+// Frictional fluid (Anura3D manual §7.2.3, eq. (7.38), spec §A.16.3): the Bingham fluid with
+// tau_y = c cos(phi) + p sin(phi), p = max(0, -tr(sigma)/3). materials/frictional_fluid.h.
+struct FrictionalFluidParams {
+  Real bulk_modulus = 0;    // K = rho0 c0^2 [Pa]
+  Real viscosity = 0;       // mu_d, viscosity above yield [Pa s]
+  Real friction_angle = 0;  // phi [rad]
+  Real cohesion = 0;        // c [Pa]
+  Real max_viscosity = 0;   // mu_max, cap of mu_eff below the yield rate [Pa s]
+  EquationOfState equation_of_state = EquationOfState::kLinear;
+  Real tait_gamma = 7;      // Tait exponent gamma [-] (kTait only)
+};
+
 using MaterialParams =
-    std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams>;
+    std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams,
+                 BinghamFluidParams, FrictionalFluidParams>;
+
+// Fluids: stress from J and d only (no shear modulus, no elastic state).
+template <class P>
+inline constexpr bool kIsFluid = std::is_same_v<P, NewtonianFluidParams> ||
+                                 std::is_same_v<P, BinghamFluidParams> ||
+                                 std::is_same_v<P, FrictionalFluidParams>;
 
 // Elastoplastic models: Hencky elasticity in Kirchhoff stress with b^e as the state (Table 3.4).
 // Their stress update is PlasticUpdate(params, f, J, b^e, history, sigma), found by overload.
 template <class P>
 inline constexpr bool kIsElastoplastic =
     !std::is_same_v<P, LinearElasticParams> && !std::is_same_v<P, NeoHookeanParams> &&
-    !std::is_same_v<P, NewtonianFluidParams>;
+    !kIsFluid<P>;
 
 struct Material {
   std::string name;
@@ -76,7 +107,7 @@ inline Real LameLambda(Real bulk, Real shear) { return bulk - 2.0 * shear / 3.0;
 inline Real WaveSpeed(const Material& m) {
   return std::visit(
       [&](const auto& p) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(p)>, NewtonianFluidParams>) {
+        if constexpr (kIsFluid<std::decay_t<decltype(p)>>) {
           return std::sqrt(p.bulk_modulus / m.density);
         } else {
           return std::sqrt((p.bulk_modulus + 4.0 * p.shear_modulus / 3.0) / m.density);

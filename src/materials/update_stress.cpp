@@ -4,6 +4,8 @@
 #include <array>
 
 #include "core/parallel.h"
+#include "materials/bingham_fluid.h"
+#include "materials/frictional_fluid.h"
 #include "materials/hencky.h"
 #include "materials/j2.h"
 #include "materials/linear_elastic.h"
@@ -69,6 +71,26 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                                                           velocity_gradient[p]);  // (6.1)-(6.2)
                      });
                    },
+                   [&](const BinghamFluidParams& params) {
+                     ParallelFor(count, 1024, [&](size_t k) {
+                       const size_t p = g.begin + k;
+                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
+                       P.F[p] = f * P.F[p];
+                       P.strain[p] += Sym(f - Mat3::Identity());
+                       BinghamFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p], dt,
+                                          P.history[p], P.stress[p]);  // A3D (7.37)
+                     });
+                   },
+                   [&](const FrictionalFluidParams& params) {
+                     ParallelFor(count, 1024, [&](size_t k) {
+                       const size_t p = g.begin + k;
+                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
+                       P.F[p] = f * P.F[p];
+                       P.strain[p] += Sym(f - Mat3::Identity());
+                       FrictionalFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p],
+                                             dt, P.history[p], P.stress[p]);  // A3D (7.38)
+                     });
+                   },
                },
                model.materials[g.material].params);
   }
@@ -87,6 +109,12 @@ Real StrainEnergyDensity(const Material& material, const Mat3& F, const Mat3& st
                         },
                         [&](const NewtonianFluidParams& p) {
                           return NewtonianFluidEnergy(p, F.determinant());
+                        },
+                        [&](const BinghamFluidParams& p) {  // EOS part only
+                          return NewtonianFluidEnergy(EquationOfStateOf(p), F.determinant());
+                        },
+                        [&](const FrictionalFluidParams& p) {  // EOS part only
+                          return NewtonianFluidEnergy(EquationOfStateOf(p), F.determinant());
                         },
                     },
                     material.params);

@@ -2,6 +2,7 @@
 // ranges and defaults, and the constructor of its parameter struct. The parser, the writer and
 // the builder all read this table, so a new model adds a MaterialModel value, a params struct in
 // materials/material_params.h and one row here (docs/scene-reference.md lists the keys).
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -55,7 +56,62 @@ std::optional<ParamError> CheckNewtonianFluid(const MaterialSpec& m) {
   return std::nullopt;
 }
 
-// Geostatic initial stress is refused for hyperelastic models and fluids: their stress is a
+// --- bingham_fluid, frictional_fluid (Anura3D manual §7.2.2-7.2.3) ---------------------------
+
+// mu_max when not written: 1000 mu_d (docs/materials.md: creep rate tau / mu_max vs the viscous
+// time step, which scales with 1 / mu_max).
+constexpr Real kDefaultMaxViscosityRatio = 1000;
+Real MaxViscosity(const MaterialSpec& m) {
+  return m.values.count("max_viscosity") ? m.Param("max_viscosity")
+                                         : kDefaultMaxViscosityRatio * m.Param("viscosity");
+}
+constexpr ParamDesc kBinghamKeys[] = {
+    {"bulk_modulus", "Pa", 0, true, kInf, false, true},      // K > 0
+    {"viscosity", "Pa s", 0, false, kInf, false, false},     // mu_d >= 0
+    {"yield_stress", "Pa", 0, false, kInf, false, true},     // tau_y >= 0
+    {"max_viscosity", "Pa s", 0, true, kInf, false, false},  // mu_max > mu_d; 1000 mu_d
+    {"equation_of_state", "", 0, false, kInf, false, false, 0, kEosChoices},
+    {"tait_gamma", "-", 1, true, kInf, false, false, 7},  // gamma > 1
+};
+MaterialParams MakeBinghamFluid(const MaterialSpec& m) {
+  return BinghamFluidParams{m.Param("bulk_modulus"), m.Param("viscosity"),
+                            m.Param("yield_stress"), MaxViscosity(m),
+                            static_cast<EquationOfState>(m.Param("equation_of_state")),
+                            m.Param("tait_gamma")};
+}
+constexpr ParamDesc kFrictionalKeys[] = {
+    {"bulk_modulus", "Pa", 0, true, kInf, false, true},      // K > 0
+    {"viscosity", "Pa s", 0, false, kInf, false, false},     // mu_d >= 0
+    {"friction_angle", "deg", 0, false, 90, true, true},     // 0 <= phi < 90
+    {"cohesion", "Pa", 0, false, kInf, false, false},        // c >= 0
+    {"max_viscosity", "Pa s", 0, true, kInf, false, false},  // mu_max > mu_d; 1000 mu_d
+    {"equation_of_state", "", 0, false, kInf, false, false, 0, kEosChoices},
+    {"tait_gamma", "-", 1, true, kInf, false, false, 7},  // gamma > 1
+};
+MaterialParams MakeFrictionalFluid(const MaterialSpec& m) {
+  return FrictionalFluidParams{m.Param("bulk_modulus"), m.Param("viscosity"),
+                               m.Param("friction_angle") * std::numbers::pi / 180.0,
+                               m.Param("cohesion"), MaxViscosity(m),
+                               static_cast<EquationOfState>(m.Param("equation_of_state")),
+                               m.Param("tait_gamma")};
+}
+// Cross-key rules of both: the EOS rule of the Newtonian fluid, and mu_max > mu_d (given, or
+// mu_d > 0 for the 1000 mu_d default).
+std::optional<ParamError> CheckViscoplasticFluid(const MaterialSpec& m) {
+  if (auto e = CheckNewtonianFluid(m)) return e;
+  if (!m.values.count("max_viscosity") && m.Param("viscosity") == 0) {
+    return ParamError{"max_viscosity",
+                      "max_viscosity (the cap mu_max [Pa s]) is required when viscosity is 0; "
+                      "its default is 1000 x viscosity"};
+  }
+  if (MaxViscosity(m) <= m.Param("viscosity")) {
+    return ParamError{"max_viscosity", "max_viscosity must exceed viscosity (" +
+                                           std::to_string(m.Param("viscosity")) + " Pa s)"};
+  }
+  return std::nullopt;
+}
+
+ is refused for hyperelastic models and fluids: their stress is a
 // function of F (and L), and F starts at I. Elastoplastic models accept it: their stress is a
 // function of the elastic b^e, which InitialHistory sets from the prescribed stress.
 constexpr MaterialKind kMaterialKinds[] = {
@@ -64,6 +120,10 @@ constexpr MaterialKind kMaterialKinds[] = {
     {"j2", MaterialModel::kJ2, true, true, kJ2Keys, &MakeJ2},
     {"newtonian_fluid", MaterialModel::kNewtonianFluid, false, false, kFluidKeys,
      &MakeNewtonianFluid, &CheckNewtonianFluid},
+    {"bingham_fluid", MaterialModel::kBinghamFluid, false, false, kBinghamKeys,
+     &MakeBinghamFluid, &CheckViscoplasticFluid},
+    {"frictional_fluid", MaterialModel::kFrictionalFluid, false, false, kFrictionalKeys,
+     &MakeFrictionalFluid, &CheckViscoplasticFluid},
 };
 
 }  // namespace

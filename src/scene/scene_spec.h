@@ -53,7 +53,14 @@ struct DomainSpec {
 
 // Material models known to the scene file; names and constructors live in the one table in
 // material_kinds.cpp (MaterialKinds()).
-enum class MaterialModel { kLinearElastic, kNeoHookean, kJ2, kNewtonianFluid };
+enum class MaterialModel {
+  kLinearElastic,
+  kNeoHookean,
+  kJ2,
+  kNewtonianFluid,
+  kBinghamFluid,
+  kFrictionalFluid,
+};
 
 struct MaterialSpec {
   std::string name;  // the key under `materials`

@@ -9,6 +9,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
+#include <variant>
 
 #include "core/parallel.h"
 #include "materials/update_stress.h"
@@ -82,10 +85,35 @@ Real NextTimeStep(const Model& model, const State& state) {
       if (g.end > g.begin) max_speed = std::max(max_speed, c + vmax);
     }
     dt = max_speed > 0 ? model.time.cfl * model.dx / max_speed : model.time.max_dt;  // spec §1.7
-    dt = std::min(dt, model.time.max_dt);
+    dt = std::min({dt, ViscousTimeStep(model, state), model.time.max_dt});
   }
   // Land exactly on the end time; never take a sliver step afterwards.
   if (remaining > 0 && dt > remaining) dt = remaining;
+  return dt;
+}
+
+Real ViscousTimeStep(const Model& model, const State& state) {
+  Real dt = std::numeric_limits<Real>::infinity();
+  for (const MaterialGroup& g : state.groups) {
+    if (g.end == g.begin) continue;
+    const Material& m = model.materials[g.material];
+    const Real eta = std::visit(  // longitudinal viscosity eta_L [Pa s]
+        [](const auto& p) -> Real {
+          using P = std::decay_t<decltype(p)>;
+          if constexpr (std::is_same_v<P, NewtonianFluidParams>) {
+            return 2 * p.viscosity;  // sigma = 2 mu d (6.2): eta_L = 2 mu
+          } else if constexpr (kIsFluid<P>) {
+            return 4.0 / 3.0 * p.max_viscosity;  // sigma = 2 mu_eff dev d: eta_L = 4/3 mu_max
+          } else {
+            return 0;
+          }
+        },
+        m.params);
+    // FTCS diffusion bound (eta_L / rho0) dt / dx^2 <= 1 / (2 dim), scaled by C.
+    if (eta > 0) {
+      dt = std::min(dt, model.time.cfl * m.density * model.dx * model.dx / (2 * model.dim * eta));
+    }
+  }
   return dt;
 }
 

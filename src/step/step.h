@@ -33,9 +33,19 @@ using Pipeline = std::vector<PipelineStage>;
 // The stages this model needs, in cycle order; unneeded stages are not in the list.
 Pipeline MakePipeline(const Model& model);
 
-// Time step for the next step: CFL rule dt = C dx / max_p (c_p + |v_p|) (spec §1.7), bounded by
-// max_dt, the fixed override and the remaining time to Model::time.end.
+// Time step for the next step: CFL rule dt = C dx / max_p (c_p + |v_p|) (spec §1.7) and the
+// viscous limit (ViscousTimeStep), bounded by max_dt, the fixed override and the remaining time
+// to Model::time.end.
 Real NextTimeStep(const Model& model, const State& state);
+
+// Viscous (diffusion) limit of the explicit step over the materials that have particles:
+// dt_v = C rho0 dx^2 / (2 dim eta_L), C = time.cfl, eta_L the longitudinal viscosity: 2 mu for
+// newtonian_fluid (sigma = 2 mu d), 4/3 mu_max for bingham_fluid and frictional_fluid
+// (sigma = 2 mu_eff dev d, mu_eff <= mu_max). Infinity when no material is viscous. Source: the
+// FTCS stability bound nu dt / dx^2 <= 1 / (2 dim) of explicit diffusion (von Neumann; Press et
+// al., Numerical Recipes 3rd ed. §20.2), the form Morris, Fox & Zhu (1997, J. Comput. Phys.
+// 136:214-226) use for SPH (dt <= 0.125 h^2 / nu). docs/scene-reference.md, `time`.
+Real ViscousTimeStep(const Model& model, const State& state);
 
 // Advances the state by one step. After it, report.health says whether the state is usable.
 void Step(const Model& model, const Pipeline& pipeline, State& state, Workspace& work,

@@ -236,6 +236,28 @@ TEST(SceneParserTest, FluidKeys) {
               "materials.steel.tait_gamma", "must be > 1 [-], got 1");
 }
 
+// Bingham and frictional fluid (materials/bingham_fluid.h): mu_max needs mu_d > 0 for its
+// default (1000 mu_d) and must exceed mu_d; the friction angle is in [0, 90) degrees.
+TEST(SceneParserTest, ViscoplasticFluidKeys) {
+  const std::string mud = "{model: bingham_fluid, density: 1800, bulk_modulus: 1.6e6, ";
+  ExpectError(WithMaterial(mud + "yield_stress: 200}"), 7, "materials.steel",
+              "max_viscosity (the cap mu_max [Pa s]) is required when viscosity is 0");
+  ExpectError(WithMaterial(mud + "viscosity: 5, yield_stress: 200, max_viscosity: 5}"), 7,
+              "materials.steel.max_viscosity", "max_viscosity must exceed viscosity");
+  ExpectError(WithMaterial(mud + "viscosity: 5}"), 7, "materials.steel.yield_stress",
+              "missing required key 'yield_stress'");
+  ExpectError(WithMaterial(mud + "viscosity: 5, yield_stress: 200, tait_gamma: 7}"), 7,
+              "materials.steel.tait_gamma", "tait_gamma applies only with equation_of_state: tait");
+  const std::string sand = "{model: frictional_fluid, density: 1800, bulk_modulus: 1.6e6, ";
+  ExpectError(WithMaterial(sand + "viscosity: 1, friction_angle: 90}"), 7,
+              "materials.steel.friction_angle", "got 90");
+  ExpectError(WithMaterial(sand + "viscosity: 1, friction_angle: 30, cohesion: -1}"), 7,
+              "materials.steel.cohesion", "must be >= 0 [Pa], got -1");
+  const LoadedScene ok = LoadSceneFromString(
+      WithMaterial(mud + "viscosity: 5, yield_stress: 200}"), "ok.yaml");
+  EXPECT_EQ(std::get<BinghamFluidParams>(ok.model.materials[0].params).max_viscosity, 5000);
+}
+
 TEST(SceneParserTest, GeostaticOnFluid) {
   const std::string text =
       WithMaterial("{model: newtonian_fluid, density: 1000, bulk_modulus: 2e7, viscosity: 0}") +
@@ -549,7 +571,11 @@ TEST(SceneResolvedYamlTest, RereadsPlasticAndFluidMaterials) {
         "isotropic_hardening: 2e8}",
         "{model: newtonian_fluid, density: 997.5, bulk_modulus: 2e7, viscosity: 0.001, "
         "equation_of_state: tait, tait_gamma: 7.15}",
-        "{model: newtonian_fluid, density: 997.5, bulk_modulus: 2e7, viscosity: 0}"}) {
+        "{model: newtonian_fluid, density: 997.5, bulk_modulus: 2e7, viscosity: 0}",
+        "{model: bingham_fluid, density: 1800, bulk_modulus: 1.6e6, viscosity: 5, "
+        "yield_stress: 200}",
+        "{model: frictional_fluid, density: 1800, bulk_modulus: 1.6e6, viscosity: 1, "
+        "friction_angle: 30, cohesion: 50, max_viscosity: 400, equation_of_state: tait}"}) {
     const LoadedScene a = LoadSceneFromString(WithMaterial(material), "s.yaml");
     const LoadedScene b = LoadSceneFromString(a.resolved_yaml, "resolved.yaml");
     EXPECT_EQ(b.resolved_yaml, a.resolved_yaml);
