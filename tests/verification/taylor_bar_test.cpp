@@ -170,8 +170,8 @@ TEST(TaylorBarTest, SeedBarRunsStablyAndShortensMonotonically) {
   WriteCsv(run, full ? "taylor_bar_seed_full.csv" : "taylor_bar_seed_coarse.csv",
            "T,H_bar,R_bar,R_outer_bar,KE_ratio", kSeedEnd, kSeedH0, kSeedR0, 200);
 
-  // H̄ never rises above its running minimum by more than the noise band: 0.5 % of H0 (a
-  // quarter of a particle spacing at h = 2 cm; elastic ringing of the rear is ~ sigma_Y/E = 0.1 %).
+  // H̄ never rises above its running minimum by more than the noise band: 0.5 % of H0 (0.14 of a
+  // particle spacing at h = 2 cm; elastic ringing of the rear is ~ sigma_Y/E = 0.1 %).
   Real lowest = s0.height;
   for (const Sample& s : run.samples) {
     EXPECT_LE(s.height, lowest + 0.005 * kSeedH0) << "H rose at T = " << s.t / kSeedEnd;
@@ -192,7 +192,7 @@ TEST(TaylorBarTest, SeedBarRunsStablyAndShortensMonotonically) {
 // ---- Copper bar (Kamoulakos 1990 benchmark) ----
 constexpr Real kCuL0 = 0.0324, kCuR0 = 0.0032, kCuEnd = 8.0e-5;
 // Published final length and foot radius [m]: reference FE solutions of this bilinear material
-// (docs/taylor_bar.md, "Copper comparison"); the middle of the quoted ranges.
+// (docs/taylor_bar.md, "Copper bar"); the middle of the quoted ranges.
 constexpr Real kCuPublishedL = 0.021445, kCuPublishedR = 0.00705;
 
 TEST(TaylorBarTest, CopperBarFinalShapeNearThePublishedBenchmark) {
