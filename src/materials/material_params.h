@@ -36,6 +36,18 @@ struct J2Params {
   Real kinematic_hardening = 0;  // H, Prager modulus, back stress = 2/3 H alpha_kin [Pa]
 };
 
+// Dense snow: modified Cam-clay with cohesion (Gaume et al. 2018, Nat. Commun. 9:3047, Methods):
+// y = (1 + 2 beta) q^2 + M^2 (p + beta p0)(p - p0) <= 0, p compression positive, hardening
+// p0 = K sinh(xi max(-eps_v^p, 0)); Hencky elasticity; history layout in materials/snow.h.
+struct SnowParams {
+  Real bulk_modulus = 0;            // K [Pa]; also the scale of the hardening law
+  Real shear_modulus = 0;           // G [Pa]
+  Real critical_state_slope = 0;    // M, slope of the Cam-clay ellipse (beta = 0: q/p at CS) [-]
+  Real cohesion_ratio = 0;          // beta, tensile / compressive strength of the cap [-]
+  Real hardening_factor = 0;        // xi, compaction hardening factor of the sinh law [-]
+  Real consolidation_pressure = 0;  // p0 at the start (compressive strength of the cap) [Pa]
+};
+
 // Pressure law of the Newtonian fluid.
 enum class EquationOfState {
   kLinear,  // sigma_m = K ln(J) / J (Mast 2013 eq. (6.1) with theta = ln J)
@@ -77,7 +89,7 @@ struct FrictionalFluidParams {
 
 using MaterialParams =
     std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams,
-                 BinghamFluidParams, FrictionalFluidParams>;
+                 BinghamFluidParams, FrictionalFluidParams, SnowParams>;
 
 // Fluids: stress from J and d only (no shear modulus, no elastic state).
 template <class P>

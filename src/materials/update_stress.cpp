@@ -11,6 +11,7 @@
 #include "materials/linear_elastic.h"
 #include "materials/neo_hookean.h"
 #include "materials/newtonian_fluid.h"
+#include "materials/snow.h"
 
 namespace surge {
 namespace {

@@ -111,7 +111,31 @@ std::optional<ParamError> CheckViscoplasticFluid(const MaterialSpec& m) {
   return std::nullopt;
 }
 
- is refused for hyperelastic models and fluids: their stress is a
+// --- snow (cohesive modified Cam-clay, Gaume et al. 2018) ------------------------------------
+
+constexpr ParamDesc kSnowKeys[] = {
+    {"critical_state_slope", "-", 0, true, kInf, false, true},    // M > 0
+    {"cohesion_ratio", "-", 0, false, 1, true, true},             // 0 <= beta < 1
+    {"hardening_factor", "-", 0, true, kInf, false, true},        // xi > 0
+    {"consolidation_pressure", "Pa", 0, false, kInf, false, true},  // p0 >= 0 at the start
+};
+MaterialParams MakeSnow(const MaterialSpec& m) {
+  return SnowParams{m.bulk_modulus, m.shear_modulus, m.Param("critical_state_slope"),
+                    m.Param("cohesion_ratio"), m.Param("hardening_factor"),
+                    m.Param("consolidation_pressure")};
+}
+// Critical-state friction angle for `k0: jaky`: sin phi = 3 M_cs / (6 + M_cs) (triaxial
+// compression, Wood 1990), M_cs = M (1 + beta) / ((1 - beta) sqrt(1 + 2 beta)) the q/p ratio at
+// the top of the ellipse (materials/snow.h).
+Real SnowFrictionAngleDeg(const MaterialSpec& m) {
+  const Real beta = m.Param("cohesion_ratio");
+  const Real ratio =
+      m.Param("critical_state_slope") * (1 + beta) / ((1 - beta) * std::sqrt(1 + 2 * beta));
+  const Real sin_phi = 3 * ratio / (6 + ratio);  // < 1 for ratio < 3
+  return std::asin(sin_phi < 1 ? sin_phi : 1) * 180.0 / std::numbers::pi;
+}
+
+// Geostatic initial stress is refused for hyperelastic models and fluids: their stress is a
 // function of F (and L), and F starts at I. Elastoplastic models accept it: their stress is a
 // function of the elastic b^e, which InitialHistory sets from the prescribed stress.
 constexpr MaterialKind kMaterialKinds[] = {
@@ -124,6 +148,8 @@ constexpr MaterialKind kMaterialKinds[] = {
      &MakeBinghamFluid, &CheckViscoplasticFluid},
     {"frictional_fluid", MaterialModel::kFrictionalFluid, false, false, kFrictionalKeys,
      &MakeFrictionalFluid, &CheckViscoplasticFluid},
+    {"snow", MaterialModel::kSnow, true, true, kSnowKeys, &MakeSnow, nullptr,
+     &SnowFrictionAngleDeg},
 };
 
 }  // namespace

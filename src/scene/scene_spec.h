@@ -60,6 +60,7 @@ enum class MaterialModel {
   kNewtonianFluid,
   kBinghamFluid,
   kFrictionalFluid,
+  kSnow,
 };
 
 struct MaterialSpec {

@@ -258,6 +258,32 @@ TEST(SceneParserTest, ViscoplasticFluidKeys) {
   EXPECT_EQ(std::get<BinghamFluidParams>(ok.model.materials[0].params).max_viscosity, 5000);
 }
 
+// Dense snow (materials/snow.h): M and xi > 0, 0 <= beta < 1, p0 >= 0, all required; the
+// elastic pair as for every solid.
+TEST(SceneParserTest, SnowKeys) {
+  const std::string snow = "{model: snow, density: 300, youngs_modulus: 3e6, poisson_ratio: 0.3, ";
+  const std::string rest = "hardening_factor: 0.5, consolidation_pressure: 3000";
+  ExpectError(WithMaterial(snow + "cohesion_ratio: 0.3, " + rest + "}"), 7,
+              "materials.steel.critical_state_slope", "missing required key 'critical_state_slope'");
+  ExpectError(WithMaterial(snow + "critical_state_slope: 1.2, cohesion_ratio: 1, " + rest + "}"),
+              7, "materials.steel.cohesion_ratio", "got 1");
+  ExpectError(WithMaterial(snow + "critical_state_slope: 1.2, cohesion_ratio: 0.3, "
+                                  "hardening_factor: 0, consolidation_pressure: 3000}"),
+              7, "materials.steel.hardening_factor", "must be > 0 [-], got 0");
+  ExpectError(WithMaterial(snow + "critical_state_slope: 1.2, cohesion_ratio: 0.3, "
+                                  "hardening_factor: 0.5, consolidation_pressure: -1}"),
+              7, "materials.steel.consolidation_pressure", "must be >= 0 [Pa], got -1");
+  const LoadedScene ok = LoadSceneFromString(
+      WithMaterial(snow + "critical_state_slope: 1.2, cohesion_ratio: 0.3, " + rest + "}"),
+      "ok.yaml");
+  const SnowParams& p = std::get<SnowParams>(ok.model.materials[0].params);
+  EXPECT_EQ(p.critical_state_slope, 1.2);
+  EXPECT_EQ(p.cohesion_ratio, 0.3);
+  EXPECT_EQ(p.hardening_factor, 0.5);
+  EXPECT_EQ(p.consolidation_pressure, 3000);
+  EXPECT_NEAR(p.bulk_modulus, 3e6 / (3 * (1 - 2 * 0.3)), 1e-6);
+}
+
 TEST(SceneParserTest, GeostaticOnFluid) {
   const std::string text =
       WithMaterial("{model: newtonian_fluid, density: 1000, bulk_modulus: 2e7, viscosity: 0}") +
@@ -575,7 +601,10 @@ TEST(SceneResolvedYamlTest, RereadsPlasticAndFluidMaterials) {
         "{model: bingham_fluid, density: 1800, bulk_modulus: 1.6e6, viscosity: 5, "
         "yield_stress: 200}",
         "{model: frictional_fluid, density: 1800, bulk_modulus: 1.6e6, viscosity: 1, "
-        "friction_angle: 30, cohesion: 50, max_viscosity: 400, equation_of_state: tait}"}) {
+        "friction_angle: 30, cohesion: 50, max_viscosity: 400, equation_of_state: tait}",
+        "{model: snow, density: 300, youngs_modulus: 3e6, poisson_ratio: 0.3, "
+        "critical_state_slope: 1.2, cohesion_ratio: 0.3, hardening_factor: 0.5, "
+        "consolidation_pressure: 3000}"}) {
     const LoadedScene a = LoadSceneFromString(WithMaterial(material), "s.yaml");
     const LoadedScene b = LoadSceneFromString(a.resolved_yaml, "resolved.yaml");
     EXPECT_EQ(b.resolved_yaml, a.resolved_yaml);
