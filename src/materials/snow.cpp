@@ -176,8 +176,8 @@ void InitialPlasticHistory(const SnowParams& m, const Mat3& stress, History& h) 
     p0_needed = c / p;
   }
   const Real p0 = std::max(m.consolidation_pressure, p0_needed);
-  h[kSnowVolumetricPlastic] = -std::asinh(p0 / m.bulk_modulus) / m.hardening_factor;  // p0(alpha)
-  h[kSnowConsolidation] = p0;
+  h[kSnowVolumetricPlastic] = -std::asinh(p0 / m.bulk_modulus) / m.hardening_factor;
+  h[kSnowConsolidation] = SnowConsolidationPressure(m, h[kSnowVolumetricPlastic]);  // p0, to round-off
 }
 
 }  // namespace surge

@@ -271,6 +271,39 @@ TEST_P(SnowDriverTest, ShearAtConstantPReachesTheCriticalState) {
   }
 }
 
+// Geostatic start (InitialPlasticHistory): a stress inside the initial surface keeps p0_init; one
+// outside it (deep, normally consolidated snow) raises p0 to the smallest ellipse through it. Either
+// way the start is consistent: y <= 0 (= 0 in the second case) and a step with f = I reproduces
+// the stress without a plastic return.
+TEST_P(SnowDriverTest, GeostaticStartIsOnOrInsideTheSurface) {
+  const SnowParams p = Params();
+  for (const Real depth_stress : {0.3 * p.consolidation_pressure, 5 * p.consolidation_pressure}) {
+    const Real k0 = 0.5;  // sigma_h = K0 sigma_v, compression negative
+    const Mat3 sigma = -depth_stress * Vec3(k0, 1, k0).asDiagonal().toDenseMatrix();
+    MaterialPoint pt = MakeMaterialPoint(SnowMaterial(p), sigma);
+    const History h0 = Hist(pt);
+    const Real y0 = SnowYieldFunction(p, sigma, h0), scale = SnowYieldScale(p, sigma, h0);
+    EXPECT_LE(y0, 1e-12 * scale);
+    EXPECT_EQ(h0[kSnowConsolidation], SnowConsolidationPressure(p, h0[kSnowVolumetricPlastic]));
+    const bool outside = depth_stress > p.consolidation_pressure;  // p = 2/3 sigma_v > p0_init
+    if (outside) {
+      EXPECT_NEAR(y0, 0, 1e-12 * scale) << "raised p0 puts the stress on the surface";
+      EXPECT_GT(h0[kSnowConsolidation], p.consolidation_pressure);
+    } else {
+      EXPECT_NEAR(h0[kSnowConsolidation], p.consolidation_pressure, 1e-12 * p.consolidation_pressure);
+    }
+    StepMaterialPoint(pt, Mat3::Zero(), 1e-3);
+    const Real err = (pt.particles.stress[0] - sigma).norm() / sigma.norm();
+    std::printf("snow %s: geostatic sigma_v = %.0f Pa (K0 = 0.5): p0 = %.0f Pa (%s), y/scale = "
+                "%.1e, |sigma - sigma_0|/|sigma_0| after f = I: %.1e\n",
+                Name(), depth_stress, h0[kSnowConsolidation], outside ? "raised" : "p0_init",
+                y0 / scale, err);
+    EXPECT_LE(err, 1e-12);
+    EXPECT_NEAR(Hist(pt)[kSnowVolumetricPlastic], h0[kSnowVolumetricPlastic], 1e-15);
+    EXPECT_LE(Hist(pt)[kSnowPlasticStrain], 1e-15);  // at most a round-off return
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(DryAndWet, SnowDriverTest, ::testing::Values(0, 1));
 
 // scenes/snow_slab_3d.yaml, coarser (dx = 0.1 m, 3 cells through the 0.3 m slab, a 0.2 m wide
