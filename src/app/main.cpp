@@ -101,7 +101,9 @@ int Info() {
   std::printf("CLI11      %s\n", CLI11_VERSION);
   std::printf("shape functions: linear, gimp, quadratic_bspline, cubic_bspline\n");
   std::printf("transfers:       flip, pic_flip, apic;  updates: usl, musl\n");
-  std::printf("materials:       linear_elastic, neo_hookean\n");
+  std::string models;
+  for (const std::string& name : MaterialModelNames()) models += (models.empty() ? "" : ", ") + name;
+  std::printf("materials:       %s\n", models.c_str());
   return kExitOk;
 }
 

@@ -36,7 +36,9 @@ std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
   const Particles& P = scene.state.particles;
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     const Material& mat = m.materials[m.bodies[b].material];
-    if (!std::holds_alternative<NewtonianFluidParams>(mat.params)) continue;
+    const bool fluid = std::visit(
+        [](const auto& p) { return kIsFluid<std::decay_t<decltype(p)>>; }, mat.params);
+    if (!fluid) continue;
     Real speed = 0, top = floor;
     for (size_t p = 0; p < P.size(); ++p) {
       if (P.body[p] != int(b)) continue;

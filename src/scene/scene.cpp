@@ -28,6 +28,12 @@ LoadedScene Load(std::string path, std::string text, const std::string& source,
 
 }  // namespace
 
+std::vector<std::string> MaterialModelNames() {
+  std::vector<std::string> names;
+  for (const MaterialKind& k : MaterialKinds()) names.push_back(k.name);
+  return names;
+}
+
 LoadedScene LoadScene(const std::string& path, const std::vector<std::string>& overrides) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {

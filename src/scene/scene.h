@@ -30,4 +30,7 @@ LoadedScene LoadScene(const std::string& path, const std::vector<std::string>& o
 LoadedScene LoadSceneFromString(const std::string& text, const std::string& name_for_errors,
                                 const std::vector<std::string>& overrides = {});
 
+// Names accepted by `model:` in a scene's materials, in table order (scene/material_kinds.cpp).
+std::vector<std::string> MaterialModelNames();
+
 }  // namespace surge
