@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "core/math.h"
+#include "materials/friction_angles.h"
 
 namespace surge {
 
@@ -87,9 +88,27 @@ struct FrictionalFluidParams {
   Real tait_gamma = 7;      // Tait exponent gamma [-] (kTait only)
 };
 
+// Plastic potential of the Matsuoka-Nakai models (Mast 2013 §3.8): the MN function (3.123) (pure
+// MN, verification only) or the Drucker-Prager cone (3.108) ("MN with DP G", the seed's
+// recommended granular model).
+enum class MatsuokaNakaiPotential { kMatsuokaNakai, kDruckerPrager };
+
+// Two-surface Matsuoka-Nakai with evolving friction and dilation angles (Mast 2013 §3.7, eqs.
+// (3.120)-(3.128); spec §2.8): F = 6 kappa_F I3' - 6 I1' I2' of the shifted stress tau - c_F 1,
+// angles (3.112)-(3.114); history layout in materials/matsuoka_nakai.h.
+struct MatsuokaNakaiParams {
+  Real bulk_modulus = 0;   // K [Pa]
+  Real shear_modulus = 0;  // G [Pa]
+  Real cohesion = 0;       // c_F, hydrostatic shift: apex at sigma = c_F 1 [Pa]
+  FrictionCurve friction;  // a0..a5 of (3.113)-(3.114) (a2 in 1/Pa)
+  bool zero_dilation = false;  // psi_G forced to 0 (seed Table 7.2 runs)
+  MatsuokaNakaiPotential potential = MatsuokaNakaiPotential::kMatsuokaNakai;
+};
+
 using MaterialParams =
     std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams,
-                 BinghamFluidParams, FrictionalFluidParams, SnowParams>;
+                 BinghamFluidParams, FrictionalFluidParams, SnowParams,
+                 MatsuokaNakaiParams>;
 
 // Fluids: stress from J and d only (no shear modulus, no elastic state).
 template <class P>

@@ -9,6 +9,7 @@
 #include "materials/hencky.h"
 #include "materials/j2.h"
 #include "materials/linear_elastic.h"
+#include "materials/matsuoka_nakai.h"
 #include "materials/neo_hookean.h"
 #include "materials/newtonian_fluid.h"
 #include "materials/snow.h"

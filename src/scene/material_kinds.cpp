@@ -135,6 +135,59 @@ Real SnowFrictionAngleDeg(const MaterialSpec& m) {
   return std::asin(sin_phi < 1 ? sin_phi : 1) * 180.0 / std::numbers::pi;
 }
 
+// --- matsuoka_nakai, matsuoka_nakai_dp (Mast 2013 §3.7-§3.8; spec §2.8) --------------------
+
+// Friction curve (3.113)-(3.114): angles in degrees, a2 in 1/Pa (the seed's Table 3.5 gives 1/kPa:
+// 3.33e-4 1/kPa = 3.33e-7 1/Pa).
+constexpr const char* kDilationChoices[] = {"stress_dilatancy", "zero"};  // zero_dilation
+constexpr ParamDesc kMatsuokaNakaiKeys[] = {
+    {"cohesion", "Pa", 0, false, kInf, false, false},  // c_F >= 0, hydrostatic shift
+    {"a0", "deg", 0, true, 90, true, true},            // critical-state angle, 0 < a0 < 90
+    {"a1", "deg", 0, false, kInf, false, false},       // peak height and rate >= 0
+    {"a2", "1/Pa", 0, false, kInf, false, false},      // pressure sensitivity >= 0
+    {"a3", "-", 0, false, kInf, false, false},         // width of phi_F >= 0
+    {"a4", "deg", 0, false, 90, true, false},          // a0 - a4 = initial angle
+    {"a5", "-", 0, false, kInf, false, false},         // width of phi_cs >= 0
+    {"dilation", "", 0, false, kInf, false, false, 0, kDilationChoices},
+};
+MatsuokaNakaiParams MakeMatsuokaNakaiParams(const MaterialSpec& m,
+                                            MatsuokaNakaiPotential potential) {
+  MatsuokaNakaiParams p{m.bulk_modulus, m.shear_modulus, m.Param("cohesion"), {}, false,
+                        potential};
+  p.friction = FrictionCurve{m.Param("a0"), m.Param("a1"), m.Param("a2"),
+                             m.Param("a3"), m.Param("a4"), m.Param("a5")};
+  p.zero_dilation = m.Param("dilation") == 1;
+  return p;
+}
+MaterialParams MakeMatsuokaNakai(const MaterialSpec& m) {
+  return MakeMatsuokaNakaiParams(m, MatsuokaNakaiPotential::kMatsuokaNakai);
+}
+MaterialParams MakeMatsuokaNakaiDp(const MaterialSpec& m) {
+  return MakeMatsuokaNakaiParams(m, MatsuokaNakaiPotential::kDruckerPrager);
+}
+// phi_F must stay below 90 deg: a1 > 0 needs a3 > 0 (else phi_F grows without bound), and the
+// peak a0 + (a1/a3) exp(-1 - a3 a4 / a1) (at a2 I1 = 0, spec §2.7 [DERIVED]) must be < 90 deg.
+std::optional<ParamError> CheckMatsuokaNakai(const MaterialSpec& m) {
+  const Real a0 = m.Param("a0"), a1 = m.Param("a1"), a3 = m.Param("a3"), a4 = m.Param("a4");
+  if (a4 > a0) {
+    return ParamError{"a4", "a4 must not exceed a0 (" + std::to_string(a0) +
+                                " deg): a0 - a4 is the initial friction angle"};
+  }
+  if (a1 > 0 && a3 == 0) {
+    return ParamError{"a3", "a3 must be > 0 when a1 > 0 (phi_F = a0 + (a1 lambda - a4) "
+                            "exp(a2 I1 - a3 lambda) would grow without bound)"};
+  }
+  if (a1 > 0) {
+    const Real peak = a0 + a1 / a3 * std::exp(-1 - a3 * a4 / a1);
+    if (peak >= 89) {
+      return ParamError{"a1", "peak friction angle a0 + (a1/a3) exp(-1 - a3 a4/a1) = " +
+                                  std::to_string(peak) + " deg must be < 89 deg"};
+    }
+  }
+  return std::nullopt;
+}
+Real MatsuokaNakaiFrictionAngleDeg(const MaterialSpec& m) { return m.Param("a0"); }
+
 // Geostatic initial stress is refused for hyperelastic models and fluids: their stress is a
 // function of F (and L), and F starts at I. Elastoplastic models accept it: their stress is a
 // function of the elastic b^e, which InitialHistory sets from the prescribed stress.
@@ -150,6 +203,10 @@ constexpr MaterialKind kMaterialKinds[] = {
      &MakeFrictionalFluid, &CheckViscoplasticFluid},
     {"snow", MaterialModel::kSnow, true, true, kSnowKeys, &MakeSnow, nullptr,
      &SnowFrictionAngleDeg},
+    {"matsuoka_nakai", MaterialModel::kMatsuokaNakai, true, true, kMatsuokaNakaiKeys,
+     &MakeMatsuokaNakai, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
+    {"matsuoka_nakai_dp", MaterialModel::kMatsuokaNakaiDp, true, true, kMatsuokaNakaiKeys,
+     &MakeMatsuokaNakaiDp, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
 };
 
 }  // namespace

@@ -61,6 +61,8 @@ enum class MaterialModel {
   kBinghamFluid,
   kFrictionalFluid,
   kSnow,
+  kMatsuokaNakai,
+  kMatsuokaNakaiDp,
 };
 
 struct MaterialSpec {

@@ -284,6 +284,41 @@ TEST(SceneParserTest, SnowKeys) {
   EXPECT_NEAR(p.bulk_modulus, 3e6 / (3 * (1 - 2 * 0.3)), 1e-6);
 }
 
+// Matsuoka-Nakai (materials/matsuoka_nakai.h): a0 required in (0, 90) deg, a2 in 1/Pa; cross-key
+// rules a4 <= a0, a3 > 0 when a1 > 0, peak friction angle < 89 deg.
+TEST(SceneParserTest, MatsuokaNakaiKeys) {
+  const std::string mn =
+      "{model: matsuoka_nakai_dp, density: 2000, youngs_modulus: 7.5e7, poisson_ratio: 0.33, ";
+  ExpectError(WithMaterial(mn + "a1: 7750, a3: 150}"), 7, "materials.steel.a0",
+              "missing required key 'a0'");
+  ExpectError(WithMaterial(mn + "a0: 20, a4: 25}"), 7, "materials.steel.a4",
+              "a4 must not exceed a0");
+  ExpectError(WithMaterial(mn + "a0: 20, a1: 7750, a3: 0, a4: 20}"), 7, "materials.steel.a3",
+              "a3 must be > 0 when a1 > 0");
+  ExpectError(WithMaterial(mn + "a0: 20, a1: 7750, a4: 20}"), 7, "materials.steel",
+              "a3 must be > 0 when a1 > 0");  // a3 not written: the material is blamed
+  ExpectError(WithMaterial(mn + "a0: 40, a1: 30000, a3: 150, a4: 20}"), 7, "materials.steel.a1",
+              "must be < 89 deg");
+  ExpectError(WithMaterial(mn + "a0: 20, dilation: none}"), 7, "materials.steel.dilation",
+              "expected one of: stress_dilatancy, zero");
+  const LoadedScene ok = LoadSceneFromString(
+      WithMaterial(mn + "cohesion: 5000, a0: 20, a1: 7750, a2: 3.33e-7, a3: 150, a4: 20, a5: 300, "
+                        "dilation: zero}"),
+      "ok.yaml");
+  const MatsuokaNakaiParams& p = std::get<MatsuokaNakaiParams>(ok.model.materials[0].params);
+  EXPECT_EQ(p.potential, MatsuokaNakaiPotential::kDruckerPrager);
+  EXPECT_EQ(p.cohesion, 5000);
+  EXPECT_EQ(p.friction.a1, 7750);
+  EXPECT_EQ(p.friction.a2, 3.33e-7);
+  EXPECT_EQ(p.friction.a5, 300);
+  EXPECT_TRUE(p.zero_dilation);
+  const LoadedScene pure =
+      LoadSceneFromString(WithMaterial(Replace(mn, "_dp", "") + "a0: 30}"), "ok.yaml");
+  const MatsuokaNakaiParams& q = std::get<MatsuokaNakaiParams>(pure.model.materials[0].params);
+  EXPECT_EQ(q.potential, MatsuokaNakaiPotential::kMatsuokaNakai);
+  EXPECT_FALSE(q.zero_dilation);
+}
+
 TEST(SceneParserTest, GeostaticOnFluid) {
   const std::string text =
       WithMaterial("{model: newtonian_fluid, density: 1000, bulk_modulus: 2e7, viscosity: 0}") +
