@@ -37,6 +37,25 @@ struct J2Params {
   Real kinematic_hardening = 0;  // H, Prager modulus, back stress = 2/3 H alpha_kin [Pa]
 };
 
+// Mohr-Coulomb, elastic-perfectly plastic, non-associated (Anura3D manual §7.1.2.2, (7.25)-(7.27);
+// spec seed-anura3d.md §A.16.2): planes (tau_i - tau_j) + (tau_i + tau_j) sin(phi) = 2 c cos(phi),
+// potential with psi; principal return in materials/mohr_coulomb.h (history layout there).
+struct MohrCoulombParams {
+  Real bulk_modulus = 0;    // K [Pa]
+  Real shear_modulus = 0;   // G [Pa]
+  Real friction_angle = 0;  // phi [rad], 0 <= phi < pi/2
+  Real dilation_angle = 0;  // psi [rad], 0 <= psi <= phi
+  Real cohesion = 0;        // c, Kirchhoff strength [Pa]; apex at tau_m = c cot(phi)
+};
+
+// Tresca, elastic-perfectly plastic (Anura3D manual §7.1.2.1, (7.24)): max shear |tau_i - tau_j|/2
+// <= s_u; Mohr-Coulomb with phi = psi = 0 and c = s_u (materials/mohr_coulomb.h).
+struct TrescaParams {
+  Real bulk_modulus = 0;        // K [Pa]
+  Real shear_modulus = 0;       // G [Pa]
+  Real undrained_strength = 0;  // s_u, shear strength (Kirchhoff) [Pa]
+};
+
 // Dense snow: modified Cam-clay with cohesion (Gaume et al. 2018, Nat. Commun. 9:3047, Methods):
 // y = (1 + 2 beta) q^2 + M^2 (p + beta p0)(p - p0) <= 0, p compression positive, hardening
 // p0 = K sinh(xi max(-eps_v^p, 0)); Hencky elasticity; history layout in materials/snow.h.
@@ -108,7 +127,7 @@ struct MatsuokaNakaiParams {
 using MaterialParams =
     std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams,
                  BinghamFluidParams, FrictionalFluidParams, SnowParams,
-                 MatsuokaNakaiParams>;
+                 MatsuokaNakaiParams, MohrCoulombParams, TrescaParams>;
 
 // Fluids: stress from J and d only (no shear modulus, no elastic state).
 template <class P>

@@ -188,6 +188,36 @@ std::optional<ParamError> CheckMatsuokaNakai(const MaterialSpec& m) {
 }
 Real MatsuokaNakaiFrictionAngleDeg(const MaterialSpec& m) { return m.Param("a0"); }
 
+// --- mohr_coulomb, tresca (Anura3D manual §7.1.2; materials/mohr_coulomb.h) -------------------
+
+constexpr ParamDesc kMohrCoulombKeys[] = {
+    {"friction_angle", "deg", 0, false, 90, true, true},  // 0 <= phi < 90
+    {"dilation_angle", "deg", 0, false, 90, true, false},  // 0 <= psi <= phi, default 0
+    {"cohesion", "Pa", 0, false, kInf, false, false},      // c >= 0, default 0
+};
+MaterialParams MakeMohrCoulomb(const MaterialSpec& m) {
+  return MohrCoulombParams{m.bulk_modulus, m.shear_modulus,
+                           m.Param("friction_angle") * std::numbers::pi / 180.0,
+                           m.Param("dilation_angle") * std::numbers::pi / 180.0,
+                           m.Param("cohesion")};
+}
+// psi <= phi: a dilation angle above the friction angle gives more plastic work out than in
+// (Anura3D manual §7.1.2.2; Bolton (7.28) has phi = phi_cs + 0.8 psi >= psi).
+std::optional<ParamError> CheckMohrCoulomb(const MaterialSpec& m) {
+  if (m.Param("dilation_angle") > m.Param("friction_angle")) {
+    return ParamError{"dilation_angle", "dilation_angle must not exceed friction_angle (" +
+                                            std::to_string(m.Param("friction_angle")) + " deg)"};
+  }
+  return std::nullopt;
+}
+Real MohrCoulombFrictionAngleDeg(const MaterialSpec& m) { return m.Param("friction_angle"); }
+constexpr ParamDesc kTrescaKeys[] = {
+    {"undrained_strength", "Pa", 0, true, kInf, false, true},  // s_u > 0
+};
+MaterialParams MakeTresca(const MaterialSpec& m) {
+  return TrescaParams{m.bulk_modulus, m.shear_modulus, m.Param("undrained_strength")};
+}
+
 // Geostatic initial stress is refused for hyperelastic models and fluids: their stress is a
 // function of F (and L), and F starts at I. Elastoplastic models accept it: their stress is a
 // function of the elastic b^e, which InitialHistory sets from the prescribed stress.
@@ -207,6 +237,9 @@ constexpr MaterialKind kMaterialKinds[] = {
      &MakeMatsuokaNakai, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
     {"matsuoka_nakai_dp", MaterialModel::kMatsuokaNakaiDp, true, true, kMatsuokaNakaiKeys,
      &MakeMatsuokaNakaiDp, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
+    {"mohr_coulomb", MaterialModel::kMohrCoulomb, true, true, kMohrCoulombKeys, &MakeMohrCoulomb,
+     &CheckMohrCoulomb, &MohrCoulombFrictionAngleDeg},
+    {"tresca", MaterialModel::kTresca, true, true, kTrescaKeys, &MakeTresca},
 };
 
 }  // namespace

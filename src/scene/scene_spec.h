@@ -63,6 +63,8 @@ enum class MaterialModel {
   kSnow,
   kMatsuokaNakai,
   kMatsuokaNakaiDp,
+  kMohrCoulomb,
+  kTresca,
 };
 
 struct MaterialSpec {

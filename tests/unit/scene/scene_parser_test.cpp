@@ -319,6 +319,33 @@ TEST(SceneParserTest, MatsuokaNakaiKeys) {
   EXPECT_FALSE(q.zero_dilation);
 }
 
+// Mohr-Coulomb and Tresca (materials/mohr_coulomb.h): 0 <= psi <= phi < 90 deg, c >= 0; s_u > 0.
+TEST(SceneParserTest, MohrCoulombAndTrescaKeys) {
+  const std::string mc = "{model: mohr_coulomb, density: 2000, youngs_modulus: 5e7, poisson_ratio: 0.25, ";
+  ExpectError(WithMaterial(mc + "friction_angle: 30, dilation_angle: 35}"), 7,
+              "materials.steel.dilation_angle", "dilation_angle must not exceed friction_angle");
+  ExpectError(WithMaterial(mc + "cohesion: 1e4}"), 7, "materials.steel.friction_angle",
+              "missing required key 'friction_angle'");
+  ExpectError(WithMaterial(mc + "friction_angle: 90}"), 7, "materials.steel.friction_angle",
+              "got 90");
+  ExpectError(WithMaterial(mc + "friction_angle: 30, cohesion: -1}"), 7,
+              "materials.steel.cohesion", "must be >= 0 [Pa], got -1");
+  const std::string tresca = "{model: tresca, density: 1800, youngs_modulus: 5e6, poisson_ratio: 0.3";
+  ExpectError(WithMaterial(tresca + "}"), 7, "materials.steel.undrained_strength",
+              "missing required key 'undrained_strength'");
+  ExpectError(WithMaterial(tresca + ", undrained_strength: 0}"), 7,
+              "materials.steel.undrained_strength", "must be > 0 [Pa], got 0");
+  const LoadedScene ok = LoadSceneFromString(
+      WithMaterial(mc + "friction_angle: 30, dilation_angle: 30, cohesion: 1e4}"), "ok.yaml");
+  const MohrCoulombParams& p = std::get<MohrCoulombParams>(ok.model.materials[0].params);
+  EXPECT_NEAR(std::sin(p.friction_angle), 0.5, 1e-15);  // degrees in the file, radians here
+  EXPECT_EQ(p.dilation_angle, p.friction_angle);
+  EXPECT_EQ(p.cohesion, 1e4);
+  const LoadedScene clay = LoadSceneFromString(
+      WithMaterial(tresca + ", undrained_strength: 2e4}"), "ok.yaml");
+  EXPECT_EQ(std::get<TrescaParams>(clay.model.materials[0].params).undrained_strength, 2e4);
+}
+
 TEST(SceneParserTest, GeostaticOnFluid) {
   const std::string text =
       WithMaterial("{model: newtonian_fluid, density: 1000, bulk_modulus: 2e7, viscosity: 0}") +
