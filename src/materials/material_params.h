@@ -124,10 +124,23 @@ struct MatsuokaNakaiParams {
   MatsuokaNakaiPotential potential = MatsuokaNakaiPotential::kMatsuokaNakai;
 };
 
+// Modified two-surface Drucker-Prager with evolving friction and dilation angles (Mast 2013
+// §3.6.3-3.6.4, eqs. (3.106)-(3.116); spec §2.7): the DP cone through the Mohr-Coulomb
+// compression vertices of the mobilised angle, tension cutoff at the apex; history layout in
+// materials/modified_drucker_prager.h.
+struct ModifiedDruckerPragerParams {
+  Real bulk_modulus = 0;       // K [Pa]
+  Real shear_modulus = 0;      // G [Pa]
+  Real cohesion = 0;           // c, Mohr-Coulomb cohesion (3.107) [Pa]
+  FrictionCurve friction;      // a0..a5 of (3.113)-(3.114) (a2 in 1/Pa)
+  bool zero_dilation = false;  // psi_G forced to 0 (seed Table 7.2 runs)
+};
+
 using MaterialParams =
     std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams,
                  BinghamFluidParams, FrictionalFluidParams, SnowParams,
-                 MatsuokaNakaiParams, MohrCoulombParams, TrescaParams>;
+                 MatsuokaNakaiParams, MohrCoulombParams, TrescaParams,
+                 ModifiedDruckerPragerParams>;
 
 // Fluids: stress from J and d only (no shear modulus, no elastic state).
 template <class P>

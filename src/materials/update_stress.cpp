@@ -10,6 +10,7 @@
 #include "materials/j2.h"
 #include "materials/linear_elastic.h"
 #include "materials/matsuoka_nakai.h"
+#include "materials/modified_drucker_prager.h"
 #include "materials/mohr_coulomb.h"
 #include "materials/neo_hookean.h"
 #include "materials/newtonian_fluid.h"

@@ -186,7 +186,20 @@ std::optional<ParamError> CheckMatsuokaNakai(const MaterialSpec& m) {
   }
   return std::nullopt;
 }
-Real MatsuokaNakaiFrictionAngleDeg(const MaterialSpec& m) { return m.Param("a0"); }
+// `k0: jaky` of the evolving-friction models takes the initial angle a0 - a4 (at a2 I1 = 0), so
+// that the Jaky state lies inside the initial surface (docs/scene-reference.md).
+Real MatsuokaNakaiFrictionAngleDeg(const MaterialSpec& m) {
+  return m.Param("a0") - m.Param("a4");
+}
+
+// --- modified_drucker_prager (Mast 2013 §3.6.3-3.6.4): the same keys as Matsuoka-Nakai -------
+MaterialParams MakeModifiedDruckerPrager(const MaterialSpec& m) {
+  ModifiedDruckerPragerParams p{m.bulk_modulus, m.shear_modulus, m.Param("cohesion"), {}, false};
+  p.friction = FrictionCurve{m.Param("a0"), m.Param("a1"), m.Param("a2"),
+                             m.Param("a3"), m.Param("a4"), m.Param("a5")};
+  p.zero_dilation = m.Param("dilation") == 1;
+  return p;
+}
 
 // --- mohr_coulomb, tresca (Anura3D manual §7.1.2; materials/mohr_coulomb.h) -------------------
 
@@ -237,6 +250,9 @@ constexpr MaterialKind kMaterialKinds[] = {
      &MakeMatsuokaNakai, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
     {"matsuoka_nakai_dp", MaterialModel::kMatsuokaNakaiDp, true, true, kMatsuokaNakaiKeys,
      &MakeMatsuokaNakaiDp, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
+    {"modified_drucker_prager", MaterialModel::kModifiedDruckerPrager, true, true,
+     kMatsuokaNakaiKeys, &MakeModifiedDruckerPrager, &CheckMatsuokaNakai,
+     &MatsuokaNakaiFrictionAngleDeg},
     {"mohr_coulomb", MaterialModel::kMohrCoulomb, true, true, kMohrCoulombKeys, &MakeMohrCoulomb,
      &CheckMohrCoulomb, &MohrCoulombFrictionAngleDeg},
     {"tresca", MaterialModel::kTresca, true, true, kTrescaKeys, &MakeTresca},

@@ -65,6 +65,7 @@ enum class MaterialModel {
   kMatsuokaNakaiDp,
   kMohrCoulomb,
   kTresca,
+  kModifiedDruckerPrager,
 };
 
 struct MaterialSpec {
