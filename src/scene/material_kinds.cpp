@@ -82,7 +82,7 @@ MaterialParams MakeBinghamFluid(const MaterialSpec& m) {
 constexpr ParamDesc kFrictionalKeys[] = {
     {"bulk_modulus", "Pa", 0, true, kInf, false, true},      // K > 0
     {"viscosity", "Pa s", 0, false, kInf, false, false},     // mu_d >= 0
-    {"friction_angle", "deg", 0, false, 90, true, true},     // 0 <= phi < 90
+    {"friction_angle_deg", "deg", 0, false, 90, true, true},     // 0 <= phi < 90
     {"cohesion", "Pa", 0, false, kInf, false, false},        // c >= 0
     {"max_viscosity", "Pa s", 0, true, kInf, false, false},  // mu_max > mu_d; 1000 mu_d
     {"equation_of_state", "", 0, false, kInf, false, false, 0, kEosChoices},
@@ -90,7 +90,7 @@ constexpr ParamDesc kFrictionalKeys[] = {
 };
 MaterialParams MakeFrictionalFluid(const MaterialSpec& m) {
   return FrictionalFluidParams{m.Param("bulk_modulus"), m.Param("viscosity"),
-                               m.Param("friction_angle") * std::numbers::pi / 180.0,
+                               m.Param("friction_angle_deg") * std::numbers::pi / 180.0,
                                m.Param("cohesion"), MaxViscosity(m),
                                static_cast<EquationOfState>(m.Param("equation_of_state")),
                                m.Param("tait_gamma")};
@@ -204,26 +204,26 @@ MaterialParams MakeModifiedDruckerPrager(const MaterialSpec& m) {
 // --- mohr_coulomb, tresca (Anura3D manual §7.1.2; materials/mohr_coulomb.h) -------------------
 
 constexpr ParamDesc kMohrCoulombKeys[] = {
-    {"friction_angle", "deg", 0, false, 90, true, true},  // 0 <= phi < 90
-    {"dilation_angle", "deg", 0, false, 90, true, false},  // 0 <= psi <= phi, default 0
+    {"friction_angle_deg", "deg", 0, false, 90, true, true},  // 0 <= phi < 90
+    {"dilation_angle_deg", "deg", 0, false, 90, true, false},  // 0 <= psi <= phi, default 0
     {"cohesion", "Pa", 0, false, kInf, false, false},      // c >= 0, default 0
 };
 MaterialParams MakeMohrCoulomb(const MaterialSpec& m) {
   return MohrCoulombParams{m.bulk_modulus, m.shear_modulus,
-                           m.Param("friction_angle") * std::numbers::pi / 180.0,
-                           m.Param("dilation_angle") * std::numbers::pi / 180.0,
+                           m.Param("friction_angle_deg") * std::numbers::pi / 180.0,
+                           m.Param("dilation_angle_deg") * std::numbers::pi / 180.0,
                            m.Param("cohesion")};
 }
 // psi <= phi: a dilation angle above the friction angle gives more plastic work out than in
 // (Anura3D manual §7.1.2.2; Bolton (7.28) has phi = phi_cs + 0.8 psi >= psi).
 std::optional<ParamError> CheckMohrCoulomb(const MaterialSpec& m) {
-  if (m.Param("dilation_angle") > m.Param("friction_angle")) {
-    return ParamError{"dilation_angle", "dilation_angle must not exceed friction_angle (" +
-                                            std::to_string(m.Param("friction_angle")) + " deg)"};
+  if (m.Param("dilation_angle_deg") > m.Param("friction_angle_deg")) {
+    return ParamError{"dilation_angle_deg", "dilation_angle_deg must not exceed friction_angle_deg (" +
+                                            std::to_string(m.Param("friction_angle_deg")) + " deg)"};
   }
   return std::nullopt;
 }
-Real MohrCoulombFrictionAngleDeg(const MaterialSpec& m) { return m.Param("friction_angle"); }
+Real MohrCoulombFrictionAngleDeg(const MaterialSpec& m) { return m.Param("friction_angle_deg"); }
 constexpr ParamDesc kTrescaKeys[] = {
     {"undrained_strength", "Pa", 0, true, kInf, false, true},  // s_u > 0
 };

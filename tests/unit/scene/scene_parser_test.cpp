@@ -249,9 +249,9 @@ TEST(SceneParserTest, ViscoplasticFluidKeys) {
   ExpectError(WithMaterial(mud + "viscosity: 5, yield_stress: 200, tait_gamma: 7}"), 7,
               "materials.steel.tait_gamma", "tait_gamma applies only with equation_of_state: tait");
   const std::string sand = "{model: frictional_fluid, density: 1800, bulk_modulus: 1.6e6, ";
-  ExpectError(WithMaterial(sand + "viscosity: 1, friction_angle: 90}"), 7,
-              "materials.steel.friction_angle", "got 90");
-  ExpectError(WithMaterial(sand + "viscosity: 1, friction_angle: 30, cohesion: -1}"), 7,
+  ExpectError(WithMaterial(sand + "viscosity: 1, friction_angle_deg: 90}"), 7,
+              "materials.steel.friction_angle_deg", "got 90");
+  ExpectError(WithMaterial(sand + "viscosity: 1, friction_angle_deg: 30, cohesion: -1}"), 7,
               "materials.steel.cohesion", "must be >= 0 [Pa], got -1");
   const LoadedScene ok = LoadSceneFromString(
       WithMaterial(mud + "viscosity: 5, yield_stress: 200}"), "ok.yaml");
@@ -322,13 +322,13 @@ TEST(SceneParserTest, MatsuokaNakaiKeys) {
 // Mohr-Coulomb and Tresca (materials/mohr_coulomb.h): 0 <= psi <= phi < 90 deg, c >= 0; s_u > 0.
 TEST(SceneParserTest, MohrCoulombAndTrescaKeys) {
   const std::string mc = "{model: mohr_coulomb, density: 2000, youngs_modulus: 5e7, poisson_ratio: 0.25, ";
-  ExpectError(WithMaterial(mc + "friction_angle: 30, dilation_angle: 35}"), 7,
-              "materials.steel.dilation_angle", "dilation_angle must not exceed friction_angle");
-  ExpectError(WithMaterial(mc + "cohesion: 1e4}"), 7, "materials.steel.friction_angle",
-              "missing required key 'friction_angle'");
-  ExpectError(WithMaterial(mc + "friction_angle: 90}"), 7, "materials.steel.friction_angle",
+  ExpectError(WithMaterial(mc + "friction_angle_deg: 30, dilation_angle_deg: 35}"), 7,
+              "materials.steel.dilation_angle_deg", "dilation_angle_deg must not exceed friction_angle_deg");
+  ExpectError(WithMaterial(mc + "cohesion: 1e4}"), 7, "materials.steel.friction_angle_deg",
+              "missing required key 'friction_angle_deg'");
+  ExpectError(WithMaterial(mc + "friction_angle_deg: 90}"), 7, "materials.steel.friction_angle_deg",
               "got 90");
-  ExpectError(WithMaterial(mc + "friction_angle: 30, cohesion: -1}"), 7,
+  ExpectError(WithMaterial(mc + "friction_angle_deg: 30, cohesion: -1}"), 7,
               "materials.steel.cohesion", "must be >= 0 [Pa], got -1");
   const std::string tresca = "{model: tresca, density: 1800, youngs_modulus: 5e6, poisson_ratio: 0.3";
   ExpectError(WithMaterial(tresca + "}"), 7, "materials.steel.undrained_strength",
@@ -336,7 +336,7 @@ TEST(SceneParserTest, MohrCoulombAndTrescaKeys) {
   ExpectError(WithMaterial(tresca + ", undrained_strength: 0}"), 7,
               "materials.steel.undrained_strength", "must be > 0 [Pa], got 0");
   const LoadedScene ok = LoadSceneFromString(
-      WithMaterial(mc + "friction_angle: 30, dilation_angle: 30, cohesion: 1e4}"), "ok.yaml");
+      WithMaterial(mc + "friction_angle_deg: 30, dilation_angle_deg: 30, cohesion: 1e4}"), "ok.yaml");
   const MohrCoulombParams& p = std::get<MohrCoulombParams>(ok.model.materials[0].params);
   EXPECT_NEAR(std::sin(p.friction_angle), 0.5, 1e-15);  // degrees in the file, radians here
   EXPECT_EQ(p.dilation_angle, p.friction_angle);
@@ -663,7 +663,7 @@ TEST(SceneResolvedYamlTest, RereadsPlasticAndFluidMaterials) {
         "{model: bingham_fluid, density: 1800, bulk_modulus: 1.6e6, viscosity: 5, "
         "yield_stress: 200}",
         "{model: frictional_fluid, density: 1800, bulk_modulus: 1.6e6, viscosity: 1, "
-        "friction_angle: 30, cohesion: 50, max_viscosity: 400, equation_of_state: tait}",
+        "friction_angle_deg: 30, cohesion: 50, max_viscosity: 400, equation_of_state: tait}",
         "{model: snow, density: 300, youngs_modulus: 3e6, poisson_ratio: 0.3, "
         "critical_state_slope: 1.2, cohesion_ratio: 0.3, hardening_factor: 0.5, "
         "consolidation_pressure: 3000}"}) {
