@@ -136,11 +136,21 @@ struct ModifiedDruckerPragerParams {
   bool zero_dilation = false;  // psi_G forced to 0 (seed Table 7.2 runs)
 };
 
+// Smooth-cap two-surface Drucker-Prager (Mast 2013 §3.6.2; spec §2.6): the seed's workhorse for
+// impact studies; history layout in materials/smooth_cap_drucker_prager.h.
+struct SmoothCapDruckerPragerParams {
+  Real bulk_modulus = 0;    // K [Pa]
+  Real shear_modulus = 0;   // G [Pa]
+  Real friction_slope = 0;  // varrho_F of the friction angle (3.107) [-]
+  Real yield_stress = 0;    // mu, effective yield stress (cohesion-like), > 0 [Pa]
+  Real associativity = 0;   // varrho_G / varrho_F in [0, 1] [-]
+};
+
 using MaterialParams =
     std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams,
                  BinghamFluidParams, FrictionalFluidParams, SnowParams,
                  MatsuokaNakaiParams, MohrCoulombParams, TrescaParams,
-                 ModifiedDruckerPragerParams>;
+                 ModifiedDruckerPragerParams, SmoothCapDruckerPragerParams>;
 
 // Fluids: stress from J and d only (no shear modulus, no elastic state).
 template <class P>

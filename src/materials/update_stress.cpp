@@ -14,6 +14,7 @@
 #include "materials/mohr_coulomb.h"
 #include "materials/neo_hookean.h"
 #include "materials/newtonian_fluid.h"
+#include "materials/smooth_cap_drucker_prager.h"
 #include "materials/snow.h"
 
 namespace surge {

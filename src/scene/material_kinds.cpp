@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "materials/friction_angles.h"
 #include "scene/scene_spec.h"
 
 namespace surge {
@@ -231,6 +232,20 @@ MaterialParams MakeTresca(const MaterialSpec& m) {
   return TrescaParams{m.bulk_modulus, m.shear_modulus, m.Param("undrained_strength")};
 }
 
+// --- drucker_prager_smooth_cap (Mast 2013 §3.6.2; spec §2.6) ---------------------------------
+constexpr ParamDesc kSmoothCapKeys[] = {
+    {"friction_angle_deg", "deg", 0, false, 90, true, true},  // phi in [0, 90)
+    {"yield_stress", "Pa", 0, true, kInf, false, true},       // mu > 0 (the cap needs it)
+    {"associativity", "-", 0, false, 1, false, false, 0},     // varrho_G / varrho_F in [0, 1]
+};
+MaterialParams MakeSmoothCapDruckerPrager(const MaterialSpec& m) {
+  return SmoothCapDruckerPragerParams{
+      m.bulk_modulus, m.shear_modulus,
+      DruckerPragerSlope(m.Param("friction_angle_deg") * std::numbers::pi / 180.0),  // (3.107)
+      m.Param("yield_stress"), m.Param("associativity")};
+}
+Real SmoothCapFrictionAngleDeg(const MaterialSpec& m) { return m.Param("friction_angle_deg"); }
+
 // Geostatic initial stress is refused for hyperelastic models and fluids: their stress is a
 // function of F (and L), and F starts at I. Elastoplastic models accept it: their stress is a
 // function of the elastic b^e, which InitialHistory sets from the prescribed stress.
@@ -250,6 +265,8 @@ constexpr MaterialKind kMaterialKinds[] = {
      &MakeMatsuokaNakai, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
     {"matsuoka_nakai_dp", MaterialModel::kMatsuokaNakaiDp, true, true, kMatsuokaNakaiKeys,
      &MakeMatsuokaNakaiDp, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
+    {"drucker_prager_smooth_cap", MaterialModel::kSmoothCapDruckerPrager, true, true,
+     kSmoothCapKeys, &MakeSmoothCapDruckerPrager, nullptr, &SmoothCapFrictionAngleDeg},
     {"modified_drucker_prager", MaterialModel::kModifiedDruckerPrager, true, true,
      kMatsuokaNakaiKeys, &MakeModifiedDruckerPrager, &CheckMatsuokaNakai,
      &MatsuokaNakaiFrictionAngleDeg},

@@ -66,6 +66,7 @@ enum class MaterialModel {
   kMohrCoulomb,
   kTresca,
   kModifiedDruckerPrager,
+  kSmoothCapDruckerPrager,
 };
 
 struct MaterialSpec {

@@ -715,5 +715,27 @@ TEST(SceneParametersTest, BadExpressionsNameLineAndKey) {
   EXPECT_EQ(c.file, "--set parameters.b=x");
 }
 
+
+TEST(SceneParserTest, SmoothCapDruckerPragerKeysAndJakyK0) {
+  const std::string sc =
+      "{model: drucker_prager_smooth_cap, density: 1950, bulk_modulus: 8.33e6, "
+      "shear_modulus: 3.85e6, ";
+  ExpectError(WithMaterial(sc + "friction_angle_deg: 20, yield_stress: 10, associativity: 1.5}"), 7,
+              "materials.steel.associativity", "got 1.5");
+  ExpectError(WithMaterial(sc + "friction_angle_deg: 20}"), 7, "materials.steel.yield_stress",
+              "missing required key 'yield_stress'");
+  ExpectError(WithMaterial(sc + "friction_angle: 20, yield_stress: 10}"), 7,
+              "materials.steel.friction_angle", "unknown key 'friction_angle'");
+  // k0: jaky = 1 - sin(30 deg) = 0.5: the horizontal stress is half the vertical one.
+  const LoadedScene s = LoadSceneFromString(
+      WithMaterial(sc + "friction_angle_deg: 30, yield_stress: 10}") +
+          "    initial_stress: {geostatic: {k0: jaky}}\n" + "gravity: [0, -10, 0]\n",
+      "ok.yaml");
+  const Mat3& sigma = s.state.particles.stress[0];
+  ASSERT_LT(sigma(1, 1), 0);
+  EXPECT_NEAR(sigma(0, 0) / sigma(1, 1), 0.5, 1e-12);
+  EXPECT_NE(s.resolved_yaml.find("k0: jaky"), std::string::npos) << s.resolved_yaml;
+}
+
 }  // namespace
 }  // namespace surge
