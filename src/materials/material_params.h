@@ -136,6 +136,18 @@ struct ModifiedDruckerPragerParams {
   bool zero_dilation = false;  // psi_G forced to 0 (seed Table 7.2 runs)
 };
 
+// Traditional two-surface Drucker-Prager with tension cutoff and linear isotropic/kinematic
+// hardening (Mast 2013 §3.6.1; spec §2.5); history layout in materials/drucker_prager.h.
+struct DruckerPragerParams {
+  Real bulk_modulus = 0;         // K [Pa]
+  Real shear_modulus = 0;        // G [Pa]
+  Real friction_slope = 0;       // varrho_F of the friction angle (3.107) [-]
+  Real dilation_slope = 0;       // varrho_G of the dilation angle (3.109) [-]
+  Real yield_stress = 0;         // sigma_Y: F1 = ||eta|| + varrho_F I1 - sqrt(2/3) sigma_Y at alpha = 0 [Pa]
+  Real isotropic_hardening = 0;  // k [Pa]
+  Real kinematic_hardening = 0;  // H [Pa]
+};
+
 // Smooth-cap two-surface Drucker-Prager (Mast 2013 §3.6.2; spec §2.6): the seed's workhorse for
 // impact studies; history layout in materials/smooth_cap_drucker_prager.h.
 struct SmoothCapDruckerPragerParams {
@@ -150,7 +162,8 @@ using MaterialParams =
     std::variant<LinearElasticParams, NeoHookeanParams, J2Params, NewtonianFluidParams,
                  BinghamFluidParams, FrictionalFluidParams, SnowParams,
                  MatsuokaNakaiParams, MohrCoulombParams, TrescaParams,
-                 ModifiedDruckerPragerParams, SmoothCapDruckerPragerParams>;
+                 ModifiedDruckerPragerParams, SmoothCapDruckerPragerParams,
+                 DruckerPragerParams>;
 
 // Fluids: stress from J and d only (no shear modulus, no elastic state).
 template <class P>

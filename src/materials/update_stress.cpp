@@ -5,6 +5,7 @@
 
 #include "core/parallel.h"
 #include "materials/bingham_fluid.h"
+#include "materials/drucker_prager.h"
 #include "materials/frictional_fluid.h"
 #include "materials/hencky.h"
 #include "materials/j2.h"

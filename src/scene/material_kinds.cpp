@@ -232,6 +232,36 @@ MaterialParams MakeTresca(const MaterialSpec& m) {
   return TrescaParams{m.bulk_modulus, m.shear_modulus, m.Param("undrained_strength")};
 }
 
+// --- drucker_prager (Mast 2013 §3.6.1; spec §2.5) --------------------------------------------
+constexpr ParamDesc kDruckerPragerKeys[] = {
+    {"friction_angle_deg", "deg", 0, false, 90, true, true},  // phi in [0, 90)
+    {"dilation_angle_deg", "deg", 0, false, 90, true, false},  // 0 <= psi <= phi, default 0
+    {"cohesion", "Pa", 0, false, kInf, false, false},          // c >= 0 (Mohr-Coulomb)
+    {"isotropic_hardening", "Pa"},                             // k >= 0
+    {"kinematic_hardening", "Pa"},                             // H >= 0
+};
+MaterialParams MakeDruckerPrager(const MaterialSpec& m) {
+  const Real phi = m.Param("friction_angle_deg") * std::numbers::pi / 180.0;
+  const Real psi = m.Param("dilation_angle_deg") * std::numbers::pi / 180.0;
+  // sqrt(2/3) sigma_Y = -sigma_Y^Eff of the cone through the MC compression vertices (3.107).
+  const Real sigma_y = -DruckerPragerCohesionTerm(m.Param("cohesion"), phi) / std::sqrt(2.0 / 3.0);
+  return DruckerPragerParams{m.bulk_modulus,           m.shear_modulus,
+                             DruckerPragerSlope(phi),  DruckerPragerSlope(psi),
+                             sigma_y,                  m.Param("isotropic_hardening"),
+                             m.Param("kinematic_hardening")};
+}
+std::optional<ParamError> CheckDruckerPrager(const MaterialSpec& m) {
+  if (m.Param("dilation_angle_deg") > m.Param("friction_angle_deg")) {
+    return ParamError{"dilation_angle_deg",
+                      "dilation_angle_deg must not exceed friction_angle_deg (" +
+                          std::to_string(m.Param("friction_angle_deg")) + " deg)"};
+  }
+  if (m.Param("friction_angle_deg") == 0 && m.Param("cohesion") == 0) {
+    return ParamError{"cohesion", "with friction_angle_deg 0 the cohesion must be > 0 (no strength)"};
+  }
+  return std::nullopt;
+}
+
 // --- drucker_prager_smooth_cap (Mast 2013 §3.6.2; spec §2.6) ---------------------------------
 constexpr ParamDesc kSmoothCapKeys[] = {
     {"friction_angle_deg", "deg", 0, false, 90, true, true},  // phi in [0, 90)
@@ -265,6 +295,8 @@ constexpr MaterialKind kMaterialKinds[] = {
      &MakeMatsuokaNakai, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
     {"matsuoka_nakai_dp", MaterialModel::kMatsuokaNakaiDp, true, true, kMatsuokaNakaiKeys,
      &MakeMatsuokaNakaiDp, &CheckMatsuokaNakai, &MatsuokaNakaiFrictionAngleDeg},
+    {"drucker_prager", MaterialModel::kDruckerPrager, true, true, kDruckerPragerKeys,
+     &MakeDruckerPrager, &CheckDruckerPrager, &SmoothCapFrictionAngleDeg},
     {"drucker_prager_smooth_cap", MaterialModel::kSmoothCapDruckerPrager, true, true,
      kSmoothCapKeys, &MakeSmoothCapDruckerPrager, nullptr, &SmoothCapFrictionAngleDeg},
     {"modified_drucker_prager", MaterialModel::kModifiedDruckerPrager, true, true,

@@ -67,6 +67,7 @@ enum class MaterialModel {
   kTresca,
   kModifiedDruckerPrager,
   kSmoothCapDruckerPrager,
+  kDruckerPrager,
 };
 
 struct MaterialSpec {

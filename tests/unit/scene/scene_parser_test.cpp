@@ -737,5 +737,22 @@ TEST(SceneParserTest, SmoothCapDruckerPragerKeysAndJakyK0) {
   EXPECT_NE(s.resolved_yaml.find("k0: jaky"), std::string::npos) << s.resolved_yaml;
 }
 
+
+TEST(SceneParserTest, DruckerPragerKeys) {
+  const std::string dp =
+      "{model: drucker_prager, density: 2000, bulk_modulus: 2e7, shear_modulus: 1e7, ";
+  ExpectError(WithMaterial(dp + "friction_angle_deg: 30, dilation_angle_deg: 35}"), 7,
+              "materials.steel.dilation_angle_deg", "must not exceed friction_angle_deg");
+  ExpectError(WithMaterial(dp + "friction_angle_deg: 0}"), 7, "materials.steel",
+              "cohesion must be > 0");
+  ExpectError(WithMaterial(dp + "cohesion: 1e4}"), 7, "materials.steel.friction_angle_deg",
+              "missing required key 'friction_angle_deg'");
+  const LoadedScene s = LoadSceneFromString(
+      WithMaterial(dp + "friction_angle_deg: 30, cohesion: 1e4, isotropic_hardening: 1e6}"), "ok.yaml");
+  const auto& p = std::get<DruckerPragerParams>(s.model.materials[0].params);
+  EXPECT_NEAR(p.friction_slope, std::sqrt(2.0 / 3.0) * 2 * 0.5 / 2.5, 1e-15);  // (3.107) at 30 deg
+  EXPECT_EQ(p.isotropic_hardening, 1e6);
+}
+
 }  // namespace
 }  // namespace surge
