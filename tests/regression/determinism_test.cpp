@@ -57,6 +57,18 @@ TEST(DeterminismTest, PlasticSceneIsBitwiseIdenticalForOneAndTwoThreads) {
   EXPECT_EQ(h1, h2);
 }
 
+TEST(DeterminismTest, SoilCollapseIsBitwiseIdenticalForOneAndTwoThreads) {
+  // The sand column with the modified Drucker-Prager (history: lambda and the evolving angles)
+  // and with the Matsuoka-Nakai model (principal Newton); a = 1, to t = 0.06 s (plastic by then).
+  for (const std::string model : {"modified_drucker_prager", "matsuoka_nakai_dp"}) {
+    const std::vector<std::string> overrides = {"bodies.0.particles_per_cell=2", "parameters.a=1",
+                                                "materials.sand.model=" + model};
+    const uint64_t h1 = RunWithThreads("column_collapse_2d.yaml", overrides, 0.06, 1);
+    const uint64_t h2 = RunWithThreads("column_collapse_2d.yaml", overrides, 0.06, 2);
+    EXPECT_EQ(h1, h2) << model;
+  }
+}
+
 TEST(DeterminismTest, MuslSceneIsBitwiseIdenticalForOneAndTwoThreads) {
   const uint64_t h1 = RunWithThreads("two_disks_2d.yaml", {}, 1.5, 1);
   const uint64_t h2 = RunWithThreads("two_disks_2d.yaml", {}, 1.5, 2);
