@@ -59,6 +59,8 @@ void PlasticUpdate(const ModifiedDruckerPragerParams& p, const Mat3& f, Real J, 
     const Real dgamma = F / (2.0 * G + 9.0 * K * rho_f * rho_g);
     const Real I1_new = I1 - 9.0 * K * rho_g * dgamma;  // (3.89)
     const bool overshoot = s_norm - 2.0 * G * dgamma < 0;  // past the axis (spec §2.5 [REC])
+    // dgamma < 0: 2G + 9K varrho_F varrho_G <= 0 (strongly contractive psi_G), no return along
+    // the flow direction exists; the state goes to the apex (liquefaction, docs/materials.md).
     if (!overshoot && I1_new <= apex && dgamma >= 0) {
       tau = s * (1.0 - 2.0 * G * dgamma / s_norm) + Vec3::Constant(I1_new / 3.0);
       h[kMdpLambda] += dgamma;  // (3.116), deviatoric norm of dgamma g

@@ -7,18 +7,25 @@
 //  - rigid rotations are objective, back stress included;
 //  - cone flow changes the volume by 3 varrho_G dgamma (zero for psi = 0, dilation for psi > 0);
 //  - triaxial compression reaches the Mohr-Coulomb compression strength of (phi, c);
-//  - hydrostatic tension of a cohesionless material returns to the stress-free apex.
+//  - hydrostatic tension of a cohesionless material returns to the stress-free apex;
+//  - end to end from a scene file (engine, not driver): a 2-D block (half-width 1 m, height 2 m,
+//    symmetry wall at x = 0, rough floor) under gravity stands with c = 20 kPa (critical height
+//    of a vertical cut 4 c tan(45 + phi/2) / gamma = 7 m) and collapses into a heap with c = 0;
+//    every particle stays admissible (cone and cutoff) after every step and the floor carries
+//    the weight.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 
 #include "materials/drucker_prager.h"
 #include "materials/friction_angles.h"
 #include "materials/j2.h"
 #include "materials/material_driver.h"
+#include "support/run_scene.h"
 
 namespace surge {
 namespace {
@@ -185,6 +192,84 @@ TEST(DruckerPragerTest, TriaxialCompressionAndApex) {
   MaterialPoint sand = MakeMaterialPoint(Mat(Soil(30, 0, 0)), -50e3 * Mat3::Identity());
   StepMaterialPoint(sand, 1.0 * Mat3::Identity(), 1e-2);  // 1 % stretch per axis
   EXPECT_EQ(sand.particles.stress[0].norm(), 0.0) << "cohesionless apex is stress-free";
+}
+
+// Scene of the block: the cohesion is spliced in; gravity ramps over 0.3 s (seed App. B.2.3).
+std::string BlockScene(Real cohesion) {
+  return R"(name: dp_block
+dimension: 2
+time: {end: 2.0, cfl: 0.4}
+gravity: [0, -9.81]
+gravity_ramp: 0.3
+grid: {cell_size: 0.1, shape_function: quadratic_bspline, transfer: apic, update: musl}
+domain:
+  min: [0, 0]
+  max: [4, 2.5]
+  walls: {x-: slip, x+: slip, y-: {friction: 0.6}}
+materials:
+  soil: {model: drucker_prager, density: 2000, bulk_modulus: 5e6, shear_modulus: 3e6,
+         friction_angle_deg: 30, dilation_angle_deg: 0, cohesion: )" +
+         std::to_string(cohesion) + R"(}
+bodies:
+  - name: block
+    material: soil
+    region: {box: {min: [0, 0], max: [1, 2]}}
+    particles_per_cell: 2
+)";
+}
+
+TEST(DruckerPragerTest, SceneBlockStandsWithCohesionAndCollapsesWithout) {
+  for (const Real c : {20e3, 0.0}) {
+    LoadedScene scene = LoadSceneFromString(BlockScene(c), "dp_block.yaml");
+    const auto& p = std::get<DruckerPragerParams>(scene.model.materials[0].params);
+    const Real weight = [&] {
+      Real m = 0;
+      for (const Real mp : scene.state.particles.mass) m += mp;
+      return m * 9.81;  // per metre of the plane-strain slab
+    }();
+    Real worst = 0, kinetic_peak = 0, kinetic = 0, floor = 0;
+    int samples = 0;
+    testing::RunUntil(scene, 2.0, [&](const State& s, const StepReport& r) {
+      const Particles& P = s.particles;
+      kinetic = 0;
+      for (size_t i = 0; i < P.size(); ++i) {
+        kinetic += 0.5 * P.mass[i] * P.v[i].squaredNorm();
+        const Mat3 tau = P.F[i].determinant() * P.stress[i];
+        const Real scale = std::max(tau.norm(), 1e3);
+        // Admissible: inside the cone (3.84) and below the cutoff (3.93).
+        worst = std::max(worst, DruckerPragerYield(p, tau, P.history[i]) / scale);
+        worst = std::max(worst, (tau.trace() - DruckerPragerApex(p, P.history[i])) / scale);
+      }
+      kinetic_peak = std::max(kinetic_peak, kinetic);
+      if (s.time >= 1.5) {
+        floor += -r.walls.force[int(Face::kYMin)].y();
+        ++samples;
+      }
+    });
+    floor /= samples;
+    const Particles& P = scene.state.particles;
+    Real front = 0, top = 0, alpha_max = 0;
+    for (size_t i = 0; i < P.size(); ++i) {
+      front = std::max(front, P.x[i].x());
+      top = std::max(top, P.x[i].y());
+      alpha_max = std::max(alpha_max, P.history[i][kJ2PlasticStrain]);
+    }
+    std::printf("DP scene block c = %g Pa: front %.3f m (was 1), top %.3f m (was 2), max "
+                "plastic strain %.3g, max F/scale %.2e, kinetic end/peak %.2e, floor %.5g N/m "
+                "(weight %.5g)\n",
+                c, front, top, alpha_max, worst, kinetic / kinetic_peak, floor, weight);
+    EXPECT_LE(worst, 1e-8) << "a particle left the admissible region";
+    EXPECT_NEAR(floor, weight, 0.03 * weight);
+    if (c > 0) {  // stands: a bulge below a quarter cell, settles elastically
+      EXPECT_LT(front, 1.0 + 0.05);
+      EXPECT_GT(top, 2.0 - 0.1);
+    } else {  // a cohesionless vertical face cannot stand: it slumps into a heap
+      EXPECT_GT(front, 1.5);
+      EXPECT_LT(top, 1.8);
+      EXPECT_GT(alpha_max, 0.05);
+      EXPECT_LT(kinetic, 1e-2 * kinetic_peak) << "the heap must come to rest";
+    }
+  }
 }
 
 }  // namespace

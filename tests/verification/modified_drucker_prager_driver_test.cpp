@@ -8,7 +8,10 @@
 //  - triaxial compression at a fixed angle (a1 = a4 = 0) reaches the Mohr-Coulomb compression
 //    strength q_f = 6 sin(phi) / (3 - sin(phi)) (p' + c cot(phi)) (the cone (3.107) passes
 //    through the MC compression vertices);
-//  - hydrostatic tension returns to the apex: zero stress for c = 0.
+//  - hydrostatic tension returns to the apex: zero stress for c = 0;
+//  - along a drained triaxial shearing path (a2 = 0) the mobilised strength q / p' follows the
+//    frozen angle phi_F of each step, peaks at lambda* = 1/a3 + a4/a1 with phi_F = a0 +
+//    (a1/a3) exp(-1 - a3 a4/a1) (spec §2.7 [DERIVED]) and softens to the critical angle a0.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -202,6 +205,59 @@ TEST(ModifiedDruckerPragerTest, HydrostaticTensionReturnsToTheApex) {
   MaterialPoint zero = MakeMaterialPoint(Sand(SeedSand(0)), Mat3::Zero());
   StepMaterialPoint(zero, 0.1 * Mat3::Identity(), 1e-1);
   EXPECT_TRUE(zero.particles.stress[0].allFinite());
+}
+
+TEST(ModifiedDruckerPragerTest, ShearingPathPeaksAtLambdaStarAndEndsAtA0) {
+  // a2 = 0: phi_F = a0 + (a1 lambda - a4) exp(-a3 lambda) (3.113) peaks where d phi_F / d lambda
+  // = 0, lambda* = 1/a3 + a4/a1 = 0.015, phi_F* = 30 + 20 exp(-1.5) = 34.46 deg.
+  ModifiedDruckerPragerParams p = SeedSand(0, true);
+  p.friction = FrictionCurve{30, 2000, 0, 100, 10, 50};
+  const FrictionCurve& a = p.friction;
+  const Real lambda_star = 1 / a.a3 + a.a4 / a.a1;
+  const Real phi_star = a.a0 + a.a1 / a.a3 * std::exp(-1 - a.a3 * a.a4 / a.a1);
+  MaterialPoint pt = MakeMaterialPoint(Sand(p), -100e3 * Mat3::Identity());
+  History h0;
+  InitialPlasticHistory(p, pt.particles.stress[0], h0);
+  pt.particles.history[0] = h0;
+  EXPECT_NEAR(h0[kMdpFriction], a.a0 - a.a4, 1e-12) << "geostatic start: phi_F(I1, 0)";
+  MixedControl m;
+  m.stress_controlled = {false, true, true, true, true, true};
+  m.target = -100e3 * Mat3::Identity();
+  m.target(0, 0) = 0;
+  m.L(0, 0) = -1.0;  // axial compression, 5e-4 per step
+  Real phi_peak = 0, lambda_peak = 0, worst_ratio = 0, dlambda_max = 0;
+  for (int step = 0; step < 800; ++step) {
+    const History before = pt.particles.history[0];
+    ASSERT_GE(MixedControlStep(pt, m, 5e-4, 1e-6), 0) << "step " << step;
+    const History& h = pt.particles.history[0];
+    if (h[kMdpLambda] == before[kMdpLambda]) continue;
+    dlambda_max = std::max(dlambda_max, h[kMdpLambda] - before[kMdpLambda]);
+    // Triaxial compression on the cone of the frozen angle: q = 6 sin phi / (3 - sin phi) p'.
+    const Mat3 tau = Tau(pt);
+    const Real q = tau(1, 1) - tau(0, 0), pc = -tau.trace() / 3;
+    const Real s = std::sin(Radians(before[kMdpFriction]));
+    worst_ratio = std::max(worst_ratio, std::abs(q / pc - 6 * s / (3 - s)) / (6 * s / (3 - s)));
+    if (h[kMdpFriction] > phi_peak) {
+      phi_peak = h[kMdpFriction];
+      lambda_peak = h[kMdpLambda];
+    }
+  }
+  const History& h = pt.particles.history[0];
+  std::printf("modified DP shearing path: peak phi_F %.4f deg at lambda %.5f (law: %.4f deg at "
+              "lambda* %.5f, step dlambda <= %.2e); end lambda %.3f phi_F %.6f deg (a0 %g), "
+              "phi_cs %.6f; max |q/p' - MC ratio of the frozen angle| %.2e\n",
+              phi_peak, lambda_peak, phi_star, lambda_star, dlambda_max, h[kMdpLambda],
+              h[kMdpFriction], a.a0, h[kMdpCritical], worst_ratio);
+  EXPECT_LE(worst_ratio, 1e-6);
+  EXPECT_NEAR(lambda_peak, lambda_star, dlambda_max);
+  EXPECT_LE(phi_peak, phi_star + 1e-12);
+  // The sampled peak lies within one step of lambda*: below phi_F* by at most
+  // 1/2 |phi_F''(lambda*)| dlambda^2, phi_F''(lambda*) = -a1 a3 exp(-a3 lambda*).
+  const Real curvature = a.a1 * a.a3 * std::exp(-a.a3 * lambda_star);
+  EXPECT_GE(phi_peak, phi_star - 0.5 * curvature * dlambda_max * dlambda_max);
+  EXPECT_GT(h[kMdpLambda], 0.3);
+  EXPECT_NEAR(h[kMdpFriction], a.a0, 1e-6);
+  EXPECT_NEAR(h[kMdpCritical], a.a0, 1e-6);
 }
 
 }  // namespace
