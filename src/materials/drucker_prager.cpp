@@ -16,15 +16,6 @@ namespace {
 
 const Real kSqrtTwoThirds = std::sqrt(2.0 / 3.0);
 
-void StoreBackStress(const Mat3& beta, History& h) {
-  h[kJ2BackStress + 0] = beta(0, 0);
-  h[kJ2BackStress + 1] = beta(1, 1);
-  h[kJ2BackStress + 2] = beta(2, 2);
-  h[kJ2BackStress + 3] = beta(0, 1);
-  h[kJ2BackStress + 4] = beta(1, 2);
-  h[kJ2BackStress + 5] = beta(0, 2);
-}
-
 }  // namespace
 
 Real DruckerPragerApex(const DruckerPragerParams& p, const History&) {
@@ -95,7 +86,7 @@ void PlasticUpdate(const DruckerPragerParams& p, const Mat3& f, Real J, Mat3& el
     h[kDpPlasticVolume] += 3.0 * rho_g * dgamma1 + 3.0 * dgamma2;  // tr(dg1 g_1 + dg2 g_2)
     general = H > 0 && dgamma1 > 0;
   }
-  if (H > 0) StoreBackStress(beta, h);
+  if (H > 0) J2StoreBackStress(beta, h);
   if (!general) {
     HenckyFinish(t, K, G, tau_hat.diagonal(), J, elastic_b, stress);  // Table 3.4, 5(c)-(d)
     return;

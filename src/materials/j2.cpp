@@ -13,7 +13,9 @@ namespace {
 
 const Real kSqrtTwoThirds = std::sqrt(2.0 / 3.0);
 
-void StoreBackStress(const Mat3& beta, History& h) {
+}  // namespace
+
+void J2StoreBackStress(const Mat3& beta, History& h) {
   h[kJ2BackStress + 0] = beta(0, 0);
   h[kJ2BackStress + 1] = beta(1, 1);
   h[kJ2BackStress + 2] = beta(2, 2);
@@ -21,8 +23,6 @@ void StoreBackStress(const Mat3& beta, History& h) {
   h[kJ2BackStress + 4] = beta(1, 2);
   h[kJ2BackStress + 5] = beta(0, 2);
 }
-
-}  // namespace
 
 Mat3 J2BackStressOf(const History& h) {
   Mat3 beta;
@@ -89,7 +89,7 @@ void J2Update(const J2Params& p, const Mat3& f, Real J, Mat3& elastic_b, History
       elastic_b = Q * Vec3((2.0 * eps_e).array().exp()).asDiagonal() * Q.transpose();
     }
   }
-  if (H > 0) StoreBackStress(beta, h);
+  if (H > 0) J2StoreBackStress(beta, h);
   stress = (Q * tau_hat * Q.transpose()) / J;  // sigma = tau / J (3.37)
 }
 

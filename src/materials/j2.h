@@ -29,7 +29,8 @@ inline void PlasticUpdate(const J2Params& params, const Mat3& f, Real J, Mat3& e
 // evaluated at the Kirchhoff stress tau = J sigma. F <= 0 on or inside the yield surface.
 Real J2YieldFunction(const J2Params& params, const Mat3& tau, const History& history);
 
-// Back stress beta [Pa] stored in `history`.
+// Back stress beta [Pa] stored in `history`, and its store (slots kJ2BackStress..+5).
 Mat3 J2BackStressOf(const History& history);
+void J2StoreBackStress(const Mat3& beta, History& history);
 
 }  // namespace surge

@@ -26,6 +26,7 @@
 #include "materials/j2.h"
 #include "materials/material_driver.h"
 #include "support/run_scene.h"
+#include "support/random_paths.h"
 
 namespace surge {
 namespace {
@@ -38,13 +39,7 @@ DruckerPragerParams Soil(Real phi_deg, Real psi_deg, Real c, Real k = 0, Real H 
 }
 Material Mat(const DruckerPragerParams& p) { return Material{"soil", 2000.0, p}; }
 Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0]; }
-Mat3 RandomL(std::mt19937_64& rng, Real rate) {
-  std::uniform_real_distribution<Real> u(-rate, rate);
-  Mat3 L;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) L(i, j) = u(rng);
-  return L;
-}
+using testing::RandomL;
 
 TEST(DruckerPragerTest, ReturnsEndOnTheConeOrAtTheApex) {
   struct Case {

@@ -27,6 +27,7 @@
 #include "materials/material_driver.h"
 #include "materials/update_stress.h"
 #include "support/run_scene.h"
+#include "support/random_paths.h"
 
 namespace surge {
 namespace {
@@ -62,13 +63,7 @@ Mat3 SimpleShear(Real gamma_dot) {
 // Equivalent shear stress sqrt(J2) = sqrt(1/2 s:s) [Pa]: sigma_12 in simple shear.
 Real EquivalentShear(const Mat3& sigma) { return std::sqrt(0.5 * Dev(sigma).squaredNorm()); }
 
-Mat3 RandomL(std::mt19937_64& rng, Real rate) {
-  std::uniform_real_distribution<Real> u(-rate, rate);
-  Mat3 L;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) L(i, j) = u(rng);
-  return L;
-}
+using testing::RandomL;
 
 // --- driver tests --------------------------------------------------------------------------
 

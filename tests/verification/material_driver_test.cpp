@@ -16,6 +16,7 @@
 #include "materials/material_driver.h"
 #include "materials/newtonian_fluid.h"
 #include "materials/update_stress.h"
+#include "support/random_paths.h"
 
 namespace surge {
 namespace {
@@ -42,14 +43,7 @@ Vec3 Invariants(const Mat3& sigma) {
   return Vec3(sigma.trace(), 0.5 * s.squaredNorm(), s.determinant());
 }
 
-// A random velocity gradient with entries in [-rate, rate] (fixed seed, STYLE H.9).
-Mat3 RandomL(std::mt19937_64& rng, Real rate) {
-  std::uniform_real_distribution<Real> u(-rate, rate);
-  Mat3 L;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) L(i, j) = u(rng);
-  return L;
-}
+using testing::RandomL;
 
 class J2DriverTest : public ::testing::TestWithParam<std::array<Real, 2>> {};
 

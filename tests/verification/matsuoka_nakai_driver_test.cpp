@@ -35,6 +35,7 @@
 #include "materials/hencky.h"
 #include "materials/material_driver.h"
 #include "materials/matsuoka_nakai.h"
+#include "support/random_paths.h"
 
 namespace surge {
 namespace {
@@ -64,14 +65,7 @@ Vec3 Principal(const Mat3 &a) {
   return Eigen::SelfAdjointEigenSolver<Mat3>(a, Eigen::EigenvaluesOnly)
       .eigenvalues();
 }
-Mat3 RandomL(std::mt19937_64 &rng, Real rate) {
-  std::uniform_real_distribution<Real> u(-rate, rate);
-  Mat3 L;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      L(i, j) = u(rng);
-  return L;
-}
+using testing::RandomL;
 const char *PotentialName(MatsuokaNakaiPotential p) {
   return p == MatsuokaNakaiPotential::kDruckerPrager ? "MN-DP" : "MN";
 }

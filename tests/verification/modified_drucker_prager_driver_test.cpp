@@ -22,6 +22,7 @@
 #include "materials/friction_angles.h"
 #include "materials/material_driver.h"
 #include "materials/modified_drucker_prager.h"
+#include "support/random_paths.h"
 
 namespace surge {
 namespace {
@@ -39,13 +40,7 @@ ModifiedDruckerPragerParams SeedSand(Real cohesion = 0, bool zero_dilation = fal
 }
 Material Sand(const ModifiedDruckerPragerParams& p) { return Material{"sand", 2000.0, p}; }
 Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0]; }
-Mat3 RandomL(std::mt19937_64& rng, Real rate) {
-  std::uniform_real_distribution<Real> u(-rate, rate);
-  Mat3 L;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) L(i, j) = u(rng);
-  return L;
-}
+using testing::RandomL;
 // Plastic volumetric strain ln J^p = ln J - tr(eps_e), eps_e = 1/2 ln b^e.
 Real PlasticVolume(const MaterialPoint& pt) {
   return std::log(pt.particles.F[0].determinant()) -

@@ -33,6 +33,7 @@
 #include "materials/material_driver.h"
 #include "materials/mohr_coulomb.h"
 #include "scene/scene.h"
+#include "support/random_paths.h"
 
 namespace surge {
 namespace {
@@ -68,13 +69,7 @@ Real YieldScale(const McSurface& s, const Vec3& tau) {
   return std::abs(tau.maxCoeff()) + std::abs(tau.minCoeff()) + 2 * s.cohesion * s.cos_phi;
 }
 
-Mat3 RandomL(std::mt19937_64& rng, Real rate) {
-  std::uniform_real_distribution<Real> u(-rate, rate);
-  Mat3 L;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) L(i, j) = u(rng);
-  return L;
-}
+using testing::RandomL;
 
 // A random strain path: segments of 25 steps, each with a fixed random deviatoric direction (unit
 // norm) and a volumetric bias cycling through `bias`, plus 20 % noise; L = rate x that [1/s].

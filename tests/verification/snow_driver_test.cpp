@@ -20,6 +20,7 @@
 #include "materials/material_driver.h"
 #include "materials/snow.h"
 #include "support/run_scene.h"
+#include "support/random_paths.h"
 
 namespace surge {
 namespace {
@@ -40,13 +41,7 @@ Real MeanPressure(const Mat3& tau) { return -tau.trace() / 3; }  // p, compressi
 Real ShearStress(const Mat3& tau) { return std::sqrt(1.5) * Dev(tau).norm(); }  // q
 const History& Hist(const MaterialPoint& pt) { return pt.particles.history[0]; }
 
-Mat3 RandomL(std::mt19937_64& rng, Real rate) {
-  std::uniform_real_distribution<Real> u(-rate, rate);
-  Mat3 L;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) L(i, j) = u(rng);
-  return L;
-}
+using testing::RandomL;
 
 class SnowDriverTest : public ::testing::TestWithParam<int> {
  protected:
