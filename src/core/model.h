@@ -34,6 +34,16 @@ struct Wall {
 
 enum class ExitPolicy { kRemove, kStop };
 
+// Volumetric anti-locking of a material (Mast 2013 ch. 4, AS1 control volumes; src/stabilize).
+enum class AntiLockingMethod { kNone, kNode, kCell };
+// What is projected: the trace of the total trial (elastic) Hencky strain, ln J^tr (seed §4.4.4),
+// or only that of the step's increment, ln det f (F-bar on the increment).
+enum class AntiLockingStrain { kTotal, kIncrement };
+struct AntiLocking {
+  AntiLockingMethod method = AntiLockingMethod::kNone;
+  AntiLockingStrain strain = AntiLockingStrain::kTotal;
+};
+
 struct TimeControl {
   Real end = 0;        // simulated end time [s]
   Real cfl = 0.4;      // Courant number C in dt = C dx / max(c + |v|) (spec §1.7)
@@ -69,6 +79,7 @@ struct Model {
   std::array<Wall, kFaceCount> walls;
   ExitPolicy exit_policy = ExitPolicy::kRemove;
   std::vector<Material> materials;
+  std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none
   std::vector<BodyInfo> bodies;
   OutputPlan output;
 };

@@ -13,6 +13,7 @@ enum class Stage : int {
   kGridToParticle,
   kRemapMomentum,      // MUSL only
   kVelocityGradient,   // MUSL only
+  kAntiLocking,        // only when a material is anti-locked (src/stabilize)
   kUpdateStress,
   kDomainExit,
   kCheckState,

@@ -171,6 +171,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   for (const MaterialSpec& m : spec.materials) {
     model.materials.push_back(
         Material{m.name, m.density, FindMaterialKind(m.model).make_params(m)});
+    model.antilocking.push_back(ResolvedAntiLocking(m));
   }
   for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
   model.output.every = spec.output.every;

@@ -47,6 +47,11 @@ constexpr EnumName<UpdateScheme> kUpdateNames[] = {{"usl", UpdateScheme::kUsl},
                                                    {"musl", UpdateScheme::kMusl}};
 constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
+constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockingMethod::kNone},
+                                                             {"node", AntiLockingMethod::kNode},
+                                                             {"cell", AntiLockingMethod::kCell}};
+constexpr EnumName<AntiLockingStrain> kAntiLockingStrainNames[] = {
+    {"total", AntiLockingStrain::kTotal}, {"increment", AntiLockingStrain::kIncrement}};
 constexpr EnumName<WallKind> kWallNames[] = {{"open", WallKind::kOpen},
                                              {"slip", WallKind::kSlip},
                                              {"no_slip", WallKind::kNoSlip},
@@ -456,6 +461,7 @@ std::vector<std::string> MaterialKeys(const MaterialKind& kind) {
     keys.insert(keys.end(), {"youngs_modulus", "poisson_ratio", "bulk_modulus", "shear_modulus"});
   }
   for (const ParamDesc& d : kind.params) keys.push_back(d.key);
+  keys.push_back("antilocking");
   return keys;
 }
 
@@ -498,6 +504,23 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
       Fail(v, vp, "unknown value '" + v.Scalar() + "' (expected one of: " + Join(choices) + ")");
     }
     m.values[d.key] = static_cast<Real>(it - choices.begin());
+  }
+  if (const YAML::Node al = n["antilocking"]) {
+    // antilocking: {method: none | node | cell, approach: volumetric, strain: total | increment}
+    // (docs/antilocking.md).
+    const std::string ap = Child(path, "antilocking");
+    ExpectMap(al, ap, {"method", "approach", "strain"});
+    m.antilocking = Enum(Need(al, ap, "method"), Child(ap, "method"), kAntiLockingNames);
+    if (al["strain"]) {
+      m.antilocking_strain = Enum(al["strain"], Child(ap, "strain"), kAntiLockingStrainNames);
+    }
+    if (const YAML::Node a = al["approach"]) {
+      if (!a.IsScalar() || a.Scalar() != "volumetric") {
+        Fail(a, Child(ap, "approach"),
+             "expected volumetric, got " + Describe(a) +
+                 " (the volumetric-deviatoric approach is not implemented yet, issue #4)");
+      }
+    }
   }
   if (kind.check) {
     if (const std::optional<ParamError> e = kind.check(m)) {
@@ -960,6 +983,23 @@ SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
   }
 }
 
+AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
+  AntiLocking a;
+  a.strain = m.antilocking_strain;
+  if (m.antilocking) {
+    a.method = *m.antilocking;
+  } else {
+    // Node-based for the nearly incompressible Newtonian fluid (seed ch. 4 requires anti-locking
+    // for it, §3.7 prefers node-based for wall forces); none for solids and, until verified with
+    // it, for the viscoplastic fluids.
+    const bool newtonian = std::visit(
+        [](const auto& p) { return std::is_same_v<std::decay_t<decltype(p)>, NewtonianFluidParams>; },
+        FindMaterialKind(m.model).make_params(m));
+    a.method = newtonian ? AntiLockingMethod::kNode : AntiLockingMethod::kNone;
+  }
+  return a;
+}
+
 std::string SceneSpecToYaml(const SceneSpec& spec) {
   const int dim = spec.dimension;
   YAML::Emitter e;
@@ -1026,6 +1066,11 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
         e << d.choices[static_cast<size_t>(it->second)];
       }
     }
+    const AntiLocking al = ResolvedAntiLocking(m);
+    e << YAML::Key << "antilocking" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+      << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
+      << "approach" << YAML::Value << "volumetric" << YAML::Key << "strain" << YAML::Value
+      << NameOf(kAntiLockingStrainNames, al.strain) << YAML::EndMap;
     e << YAML::EndMap;
   }
   e << YAML::EndMap;

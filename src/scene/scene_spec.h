@@ -84,6 +84,10 @@ struct MaterialSpec {
   // The model's own keys (MaterialKind::params) as written in the file; an enumerated key holds
   // the index of its choice. Keys not written take their default through Param().
   std::map<std::string, Real, std::less<>> values;
+  // `antilocking: {method, approach, strain}` (docs/antilocking.md); method unset = the default
+  // of the material's class, ResolvedAntiLocking().
+  std::optional<AntiLockingMethod> antilocking;
+  AntiLockingStrain antilocking_strain = AntiLockingStrain::kTotal;
   SourceLoc loc;
 
   // Value of a model key: as written, else the kind's default. Pre: `key` is one of the kind's.
@@ -201,6 +205,10 @@ struct SceneSpec {
 // Throws SceneError.
 SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
                          const std::string& base_dir, const std::vector<std::string>& overrides);
+
+// Anti-locking of a material: as written, else node-based volumetric on the total strain for the
+// Newtonian fluid (smooth pressure and wall forces, seed §3.7) and none for every other model.
+AntiLocking ResolvedAntiLocking(const MaterialSpec& m);
 
 // The spec as YAML with every default written out; ParseSceneSpec reads it back to an equal spec.
 std::string SceneSpecToYaml(const SceneSpec& spec);

@@ -48,6 +48,18 @@ void VelocityGradientStage(const Model& m, const StepContext& c, State& s, Works
   s.particles.x.swap(w.x_new);  // commit x_{n+1}: the re-mapped gradient needed x_n
 }
 
+void GridToParticleUslKeepStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                                StepReport&) {
+  GridToParticle(m, c, w.grid, s.particles, &w.velocity_gradient, &w.x_new);
+  s.particles.x.swap(w.x_new);  // commit x_{n+1}; x_new now holds x_n
+}
+
+void AntiLockingStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                      StepReport&) {
+  ProjectVolumetricStrain(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking,
+                          w.velocity_gradient);
+}
+
 void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                        StepReport&) {
   UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles);

@@ -16,6 +16,11 @@ void GridToParticleUslStage(const Model&, const StepContext&, State&, Workspace&
 void GridToParticleMuslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void RemapMomentumStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void VelocityGradientStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// USL with anti-locking: G2P writes L_p and x_{n+1} to scratch, then commits x_{n+1} by a swap,
+// so that (as after MUSL's VelocityGradient) Workspace::x_new holds x_n for AntiLocking.
+void GridToParticleUslKeepStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// Volumetric anti-locking of L_p (src/stabilize) with the shape functions at x_n = Workspace::x_new.
+void AntiLockingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void UpdateStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void DomainExitStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void CheckStateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);

@@ -5,6 +5,7 @@
 //   MUSL: RebuildGrid -> ReorderParticles -> ParticleToGrid -> GridUpdate -> GridToParticle -> RemapMomentum
 //         -> VelocityGradient -> UpdateStress
 //   then: DomainExit -> CheckState -> Energy
+//   AntiLocking (Mast 2013 Table 4.1) runs just before UpdateStress when a material asks for it.
 #include "step/step.h"
 
 #include <algorithm>
@@ -25,13 +26,16 @@ Pipeline MakePipeline(const Model& model) {
   p.push_back({Stage::kReorderParticles, ReorderParticlesStage});
   p.push_back({Stage::kParticleToGrid, ParticleToGridStage});                  // (2.12)
   p.push_back({Stage::kGridUpdate, GridUpdateStage});                          // (2.13)-(2.14)
+  const bool antilocking = AnyAntiLocking(model);
   if (model.scheme == UpdateScheme::kUsl) {
-    p.push_back({Stage::kGridToParticle, GridToParticleUslStage});             // (2.17), (2.22)
+    p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)
+                 antilocking ? GridToParticleUslKeepStage : GridToParticleUslStage});
   } else {
     p.push_back({Stage::kGridToParticle, GridToParticleMuslStage});            // (2.22)
     p.push_back({Stage::kRemapMomentum, RemapMomentumStage});                  // Sulsky 1995
     p.push_back({Stage::kVelocityGradient, VelocityGradientStage});            // (2.17)
   }
+  if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
   p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)
   p.push_back({Stage::kDomainExit, DomainExitStage});
   p.push_back({Stage::kCheckState, CheckStateStage});

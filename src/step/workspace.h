@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "grid/sparse_grid.h"
+#include "stabilize/antilocking.h"
 #include "transfer/transfer.h"
 
 namespace surge {
@@ -13,6 +14,7 @@ struct Workspace {
   std::vector<Vec3> x_new;              // x_{n+1} [m] (MUSL) written by GridToParticle
   std::vector<uint8_t> exit_flag;       // scratch of DomainExit and ReorderParticles
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
+  AntiLockingScratch antilocking;       // node sums of AntiLocking
 };
 
 }  // namespace surge

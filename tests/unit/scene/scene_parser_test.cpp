@@ -222,7 +222,7 @@ TEST(SceneParserTest, FluidKeys) {
   ExpectError(WithMaterial(water + "viscosity: 0.001, shear_modulus: 1e6}"), 7,
               "materials.steel.shear_modulus",
               "unknown key 'shear_modulus' (expected one of: model, density, bulk_modulus, "
-              "viscosity, equation_of_state, tait_gamma)");
+              "viscosity, equation_of_state, tait_gamma, antilocking)");
   ExpectError(WithMaterial(water + "viscosity: -0.001}"), 7, "materials.steel.viscosity",
               "must be >= 0 [Pa s], got -0.001");
   ExpectError(WithMaterial(water + "equation_of_state: tait}"), 7, "materials.steel.viscosity",
@@ -752,6 +752,44 @@ TEST(SceneParserTest, DruckerPragerKeys) {
   const auto& p = std::get<DruckerPragerParams>(s.model.materials[0].params);
   EXPECT_NEAR(p.friction_slope, std::sqrt(2.0 / 3.0) * 2 * 0.5 / 2.5, 1e-15);  // (3.107) at 30 deg
   EXPECT_EQ(p.isotropic_hardening, 1e6);
+}
+
+TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
+  const std::string steel =
+      "{model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3, ";
+  ExpectError(WithMaterial(steel + "antilocking: {method: nodes}}"), 7,
+              "materials.steel.antilocking.method", "expected one of: none, node, cell");
+  ExpectError(WithMaterial(steel + "antilocking: {approach: volumetric}}"), 7,
+              "materials.steel.antilocking.method", "missing required key 'method'");
+  ExpectError(WithMaterial(steel + "antilocking: {method: cell, approach: volumetric_deviatoric}}"),
+              7, "materials.steel.antilocking.approach", "not implemented yet");
+  ExpectError(WithMaterial(steel + "antilocking: {method: cell, smoothing: 1}}"), 7,
+              "materials.steel.antilocking.smoothing", "unknown key 'smoothing'");
+  ExpectError(WithMaterial(steel + "antilocking: {method: cell, strain: trial}}"), 7,
+              "materials.steel.antilocking.strain", "expected one of: total, increment");
+  ExpectError(WithMaterial(steel + "antilocking: node}"), 7, "materials.steel.antilocking",
+              "expected a map with keys method, approach, strain");
+  // Defaults per class: solids none, fluids node-based on the total strain.
+  const LoadedScene solid = LoadSceneFromString(kBase3, "ok.yaml");
+  ASSERT_EQ(solid.model.antilocking.size(), 1u);
+  EXPECT_EQ(solid.model.antilocking[0].method, AntiLockingMethod::kNone);
+  const LoadedScene water = LoadSceneFromString(
+      WithMaterial("{model: newtonian_fluid, density: 1000, bulk_modulus: 2e7, viscosity: 0}"),
+      "ok.yaml");
+  EXPECT_EQ(water.model.antilocking[0].method, AntiLockingMethod::kNode);
+  EXPECT_EQ(water.model.antilocking[0].strain, AntiLockingStrain::kTotal);
+  EXPECT_NE(water.resolved_yaml.find("antilocking: {method: node, approach: volumetric, strain: "
+                                     "total}"),
+            std::string::npos)
+      << water.resolved_yaml;
+  const LoadedScene cell = LoadSceneFromString(
+      WithMaterial(steel + "antilocking: {method: cell, strain: increment}}"), "ok.yaml");
+  EXPECT_EQ(cell.model.antilocking[0].method, AntiLockingMethod::kCell);
+  EXPECT_EQ(cell.model.antilocking[0].strain, AntiLockingStrain::kIncrement);
+  // The resolved YAML reads back to the same choice.
+  const LoadedScene again = LoadSceneFromString(cell.resolved_yaml, "again.yaml");
+  EXPECT_EQ(again.model.antilocking[0].method, AntiLockingMethod::kCell);
+  EXPECT_EQ(again.model.antilocking[0].strain, AntiLockingStrain::kIncrement);
 }
 
 }  // namespace

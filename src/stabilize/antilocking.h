@@ -1,0 +1,45 @@
+// Volumetric anti-locking (Mast 2013 ch. 4; spec seed-algorithms.md §3): the seed's volumetric
+// approach (AS1/VA) on node- or cell-based control volumes, in the seed's finite-deformation form
+// (§4.4.4-4.4.5) written as an F-bar-type scaling of the increment f. docs/antilocking.md has the
+// equations and measurements.
+#pragma once
+#include <vector>
+
+#include "core/model.h"
+#include "core/particles.h"
+#include "core/state.h"
+#include "core/step_context.h"
+#include "grid/sparse_grid.h"
+
+namespace surge {
+
+// Node-sized scratch of the projection, reused every step (no allocation after warm-up).
+struct AntiLockingScratch {
+  std::vector<Real> weight;    // sum_p w_ip m_p over a control volume [kg]          (4.29), (4.25)
+  std::vector<Real> weighted;  // sum_p w_ip m_p theta_p [kg]                        (4.29), (4.25)
+};
+
+// Replaces each anti-locked particle's velocity gradient L_p by (f-bar_p - I)/dt, where
+// f_p = I + dt L_p (2.18) and f-bar_p = exp((theta-bar_p - theta_p)/dim) f_p. theta_p =
+// ln(det f_p J_n) is the trace of the trial Hencky strain (4.36)-(4.38): J_n = det F_n for elastic
+// solids and fluids, J^e_n = sqrt(det b^e_n) for elastoplastic models (trial elastic strain, seed
+// §4.4.5). theta-bar_p is its mass-weighted L2 projection onto the control volumes and back (seed
+// (4.12)-(4.13) with S = [1], M = [1 1 1 0 0 0], sums (4.24)). Node-based: theta-bar_i =
+// sum N_ip m_p theta_p / sum N_ip m_p (4.29)-(4.31), theta-bar_p = sum_i N_ip theta-bar_i (4.32).
+// Cell-based: theta-bar_p = sum_{p in c} m_p theta_p / sum m_p (4.25)-(4.27). The deviatoric part
+// of f is untouched (P = I_dev, (4.16)). In 2-D (plane strain) only the in-plane block is
+// projected: determinants of the 2x2 blocks, and the factor exp(.../2) scales that block.
+// Each material group is projected over its own particles only. Reads particles (mass, volume0),
+// x_n (the positions the grid transfer used), the grid topology and binning. Writes
+// velocity_gradient of the anti-locked groups and scratch.
+// Pre: grid built from x_n this step; velocity_gradient holds L_p (2.17) of every particle.
+// Deterministic for any thread count: colour-phased block scatter as in ParticleToGrid.
+void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
+                             const std::vector<MaterialGroup>& groups, const Particles& particles,
+                             const std::vector<Vec3>& x_n, const SparseGrid& grid,
+                             AntiLockingScratch& scratch, std::vector<Mat3>& velocity_gradient);
+
+// True when any material of the model is anti-locked (the pipeline then has the stage).
+bool AnyAntiLocking(const Model& model);
+
+}  // namespace surge
