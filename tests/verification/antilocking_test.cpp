@@ -112,8 +112,10 @@ Real TankPressureRms(const std::string& method) {
   const Real h = mass / (kRho * kW);
   std::map<int64_t, std::pair<Real, int>> pressure;  // by particle id: sum of samples, count
   std::map<int64_t, Real> height;
-  testing::RunUntil(scene, kEnd, [&](const State& s, const StepReport&) {
+  std::vector<Real> floor;  // floor reaction per step [N/m]
+  testing::RunUntil(scene, kEnd, [&](const State& s, const StepReport& r) {
     if (s.time < kAvgFrom) return;
+    floor.push_back(-r.walls.force[int(Face::kYMin)].y());
     const Particles& P = s.particles;
     for (size_t p = 0; p < P.size(); ++p) {
       auto& [sum, n] = pressure[P.id[p]];
@@ -128,8 +130,14 @@ Real TankPressureRms(const std::string& method) {
     sq += dev * dev;
   }
   const Real rms = std::sqrt(sq / Real(pressure.size())) / (kRho * kG * h);
+  // Wall-force noise: RMS fluctuation of the floor reaction about the weight m g, per weight.
+  Real noise = 0;
+  for (Real f : floor) noise += (f - mass * kG) * (f - mass * kG);
+  noise = std::sqrt(noise / Real(floor.size())) / (mass * kG);
   std::printf("tank at rest, antilocking %-5s: RMS(p - rho g depth) / rho g h = %.4f (%zu "
-              "particles)\n", method.c_str(), rms, pressure.size());
+              "particles); floor force RMS(R - m g) / m g = %.2e\n",
+              method.c_str(), rms, pressure.size(), noise);
+  EXPECT_LT(noise, 0.02) << "the floor must carry the weight";
   return rms;
 }
 
