@@ -1,15 +1,19 @@
-// The only includer of HDF5 (STYLE H.10): run metadata, particle snapshots, energy series and
-// stage timings in <out>/<name>.h5. Layout and units: docs/results-format.md. The XDMF sidecar
-// is written by xdmf.cpp from the snapshot list kept here.
+// The only includer of HDF5 (STYLE H.10): run metadata, particle snapshots, energy and force
+// series and stage timings in <out>/<name>.h5, and the force series as CSV. Layout and units:
+// docs/results-format.md. The XDMF sidecar is written by xdmf.cpp from the snapshot list kept here.
 #include <hdf5.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
+#include <charconv>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <limits>
+#include <set>
 #include <vector>
 
 #include "core/parallel.h"
@@ -152,6 +156,138 @@ void ConfigureFileAccess(hid_t fapl, const std::string& path) {
   Require(H5Pset_fclose_degree(fapl, H5F_CLOSE_SEMI) >= 0, "set the close degree", path);
 }
 
+
+// --- Force series (/forces, forces_<name>.csv) ---
+
+// Pending force rows are written (HDF5 and CSV, both flushed) once this many have accumulated,
+// besides at every snapshot and on Close: a killed run loses at most the last 999 rows.
+constexpr size_t kForceFlushRows = 1000;
+constexpr hsize_t kForceChunkRows = 4096;  // as the energy columns
+
+// One structure's pending rows, column by column; cleared (capacity kept) after each flush.
+struct ForceColumns {
+  std::vector<double> time, dt, force, torque, contact_area, wetted_height, max_nodal_force;
+  std::vector<int64_t> step, contact_nodes;
+  std::vector<std::vector<double>> face_force, face_contact_area;  // [face][row (x 3)]
+  std::vector<std::vector<int64_t>> face_contact_nodes;            // [face][row]
+
+  void Resize(size_t faces) {
+    face_force.resize(faces);
+    face_contact_area.resize(faces);
+    face_contact_nodes.resize(faces);
+  }
+  void Push(Real t, int64_t s, Real step_dt, const ObstacleForce& in) {
+    time.push_back(t);
+    step.push_back(s);
+    dt.push_back(step_dt);
+    for (int d = 0; d < 3; ++d) {
+      force.push_back(in.force[d]);
+      torque.push_back(in.torque[d]);
+    }
+    contact_area.push_back(in.contact_area);
+    wetted_height.push_back(in.wetted_height);
+    max_nodal_force.push_back(in.max_nodal_force);
+    contact_nodes.push_back(in.contact_nodes);
+    for (size_t f = 0; f < in.faces.size(); ++f) {
+      for (int d = 0; d < 3; ++d) face_force[f].push_back(in.faces[f].force[d]);
+      face_contact_area[f].push_back(in.faces[f].contact_area);
+      face_contact_nodes[f].push_back(in.faces[f].contact_nodes);
+    }
+  }
+  void Clear() {
+    for (auto* v : {&time, &dt, &force, &torque, &contact_area, &wetted_height, &max_nodal_force})
+      v->clear();
+    step.clear();
+    contact_nodes.clear();
+    for (size_t f = 0; f < face_force.size(); ++f) {
+      face_force[f].clear();
+      face_contact_area[f].clear();
+      face_contact_nodes[f].clear();
+    }
+  }
+};
+
+// Structure names become HDF5 link names and file names: [A-Za-z0-9_-]+. Face names become
+// link names and CSV column prefixes, and the domain's are x-, x+, ...: [A-Za-z0-9_+-]+.
+bool IsSafeName(const std::string& name, bool allow_plus = false) {
+  if (name.empty()) return false;
+  for (char c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '-' || (allow_plus && c == '+');
+    if (!ok) return false;
+  }
+  return true;
+}
+
+std::string Join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ",") + n;
+  return out;
+}
+
+// An empty extendible n x cols dataset (cols = 0: 1-D) with a `units` attribute.
+void CreateSeries(hid_t loc, const char* name, hid_t file_type, size_t cols, const char* units,
+                  const std::string& path) {
+  const int rank = cols == 0 ? 1 : 2;
+  const hsize_t zero[2] = {0, hsize_t(cols)};
+  const hsize_t max[2] = {H5S_UNLIMITED, hsize_t(cols)};
+  const hsize_t chunk[2] = {kForceChunkRows, hsize_t(cols)};
+  Handle space(H5Screate_simple(rank, zero, max), H5Sclose);
+  Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_chunk(plist.get(), rank, chunk);
+  Handle ds(H5Dcreate2(loc, name, file_type, space.get(), H5P_DEFAULT, plist.get(), H5P_DEFAULT),
+            H5Dclose);
+  Require(ds.ok(), std::string("create dataset ") + name, path);
+  WriteStringAttr(ds.get(), "units", units, path);
+}
+
+// Appends `add` rows of data (add x cols values) to an extendible dataset that has `rows` rows.
+void AppendSeries(hid_t loc, const char* name, hid_t mem_type, const void* data, hsize_t rows,
+                  hsize_t add, size_t cols, const std::string& path) {
+  if (add == 0) return;
+  Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
+  Require(ds.ok(), std::string("open dataset ") + name, path);
+  const int rank = cols == 0 ? 1 : 2;
+  const hsize_t size[2] = {rows + add, hsize_t(cols)};
+  Require(H5Dset_extent(ds.get(), size) >= 0, std::string("extend ") + name, path);
+  Handle file_space(H5Dget_space(ds.get()), H5Sclose);
+  const hsize_t start[2] = {rows, 0}, count[2] = {add, hsize_t(cols)};
+  H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr);
+  Handle mem_space(H5Screate_simple(rank, count, nullptr), H5Sclose);
+  Require(H5Dwrite(ds.get(), mem_type, mem_space.get(), file_space.get(), H5P_DEFAULT, data) >= 0,
+          std::string("append rows to ") + name, path);
+}
+
+void WriteVectorAttr(hid_t obj, const char* name, const Vec3& value, const std::string& path) {
+  const hsize_t three = 3;
+  Handle space(H5Screate_simple(1, &three, nullptr), H5Sclose);
+  Handle attr(H5Acreate2(obj, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+              H5Aclose);
+  const double v[3] = {value.x(), value.y(), value.z()};
+  Require(attr.ok() && H5Awrite(attr.get(), H5T_NATIVE_DOUBLE, v) >= 0,
+          std::string("write attribute ") + name, path);
+}
+
+void WritePeakAttrs(hid_t obj, const ForcePeak& p, const std::string& path) {
+  WriteScalarAttr(obj, "peak_force", H5T_NATIVE_DOUBLE, p.peak_force, path);
+  WriteScalarAttr(obj, "peak_time", H5T_NATIVE_DOUBLE, p.peak_time, path);
+  WriteVectorAttr(obj, "force_at_peak", p.force_at_peak, path);
+  WriteVectorAttr(obj, "impulse", p.impulse, path);
+  WriteScalarAttr(obj, "peak_contact_area", H5T_NATIVE_DOUBLE, p.peak_contact_area, path);
+}
+
+// Shortest text that reads back to the same double (std::to_chars), e.g. "0.1", "nan".
+void AppendNumber(std::string& line, double v) {
+  char buf[32];
+  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  line.append(buf, end);
+}
+void AppendNumber(std::string& line, int64_t v) {
+  char buf[24];
+  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  line.append(buf, end);
+}
+
 }  // namespace
 
 void StrainInvariants(const Mat3& F, Real& volumetric, Real& equivalent) {
@@ -203,11 +339,106 @@ struct ResultsWriter::Impl {
   std::vector<double> position, velocity, stress;
   std::vector<double> pressure, von_mises, strain_volumetric, strain_equivalent, plastic_strain;
   bool closed = false;
+  // Force series: pending rows per structure, rows already in the .h5, one CSV per structure.
+  std::string out_dir;
+  int dim = 3;
+  bool forces_begun = false;
+  ForceSummary summary{std::vector<ForceChannel>{}};
+  std::vector<ForceColumns> force_pending;
+  size_t force_pending_rows = 0;
+  hsize_t force_rows = 0;
+  std::vector<std::string> csv_paths;
+  std::vector<FILE*> csv;
+  std::string line;  // CSV scratch
 
   Impl() { energy_sets.fill(-1); }
   ~Impl() {
     CloseHandles();
     if (fapl >= 0) H5Pclose(fapl);
+    CloseCsv();
+  }
+
+  // Appends the pending force rows to /forces/<name>/... (the CSV rows stay pending for
+  // WriteForceCsv, which follows the next Commit or file close).
+  void WriteForceRows() {
+    const hsize_t add = force_pending_rows;
+    if (add == 0) return;
+    const std::vector<ForceChannel>& channels = summary.channels();
+    for (size_t s = 0; s < channels.size(); ++s) {
+      const ForceColumns& c = force_pending[s];
+      const std::string group = "/forces/" + channels[s].name;
+      Handle g(H5Gopen2(file, group.c_str(), H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "open group " + group, h5);
+      const auto doubles = [&](hid_t loc, const char* name, const std::vector<double>& v,
+                               size_t cols) {
+        AppendSeries(loc, name, H5T_NATIVE_DOUBLE, v.data(), force_rows, add, cols, h5);
+      };
+      const auto integers = [&](hid_t loc, const char* name, const std::vector<int64_t>& v) {
+        AppendSeries(loc, name, H5T_NATIVE_INT64, v.data(), force_rows, add, 0, h5);
+      };
+      doubles(g.get(), "time", c.time, 0);
+      integers(g.get(), "step", c.step);
+      doubles(g.get(), "dt", c.dt, 0);
+      doubles(g.get(), "force", c.force, 3);
+      doubles(g.get(), "torque", c.torque, 3);
+      doubles(g.get(), "contact_area", c.contact_area, 0);
+      doubles(g.get(), "wetted_height", c.wetted_height, 0);
+      doubles(g.get(), "max_nodal_force", c.max_nodal_force, 0);
+      integers(g.get(), "contact_nodes", c.contact_nodes);
+      for (size_t f = 0; f < channels[s].faces.size(); ++f) {
+        const std::string face = "faces/" + channels[s].faces[f];
+        Handle fg(H5Gopen2(g.get(), face.c_str(), H5P_DEFAULT), H5Gclose);
+        Require(fg.ok(), "open group " + group + "/" + face, h5);
+        doubles(fg.get(), "force", c.face_force[f], 3);
+        doubles(fg.get(), "contact_area", c.face_contact_area[f], 0);
+        integers(fg.get(), "contact_nodes", c.face_contact_nodes[f]);
+      }
+    }
+    force_rows += add;
+  }
+
+  // Appends the pending rows to the CSV files, flushes them to the OS (a killed process keeps
+  // them) and clears the pending rows.
+  void WriteForceCsv() {
+    if (force_pending_rows == 0) return;
+    for (size_t s = 0; s < csv.size(); ++s) {
+      const ForceColumns& c = force_pending[s];
+      for (size_t r = 0; r < force_pending_rows; ++r) {
+        line.clear();
+        const auto number = [&](auto v) {
+          AppendNumber(line, v);
+          line += ',';
+        };
+        number(c.time[r]);
+        number(c.step[r]);
+        number(c.dt[r]);
+        for (int d = 0; d < 3; ++d) number(c.force[3 * r + d]);
+        for (int d = 0; d < 3; ++d) number(c.torque[3 * r + d]);
+        number(c.contact_area[r]);
+        number(c.wetted_height[r]);
+        number(c.max_nodal_force[r]);
+        number(c.contact_nodes[r]);
+        for (size_t f = 0; f < c.face_force.size(); ++f) {
+          for (int d = 0; d < 3; ++d) number(c.face_force[f][3 * r + d]);
+          number(c.face_contact_area[f][r]);
+          number(c.face_contact_nodes[f][r]);
+        }
+        line.back() = '\n';
+        if (std::fputs(line.c_str(), csv[s]) == EOF)
+          throw IoError("cannot write '" + csv_paths[s] + "'");
+      }
+      if (std::fflush(csv[s]) != 0) throw IoError("cannot write '" + csv_paths[s] + "'");
+    }
+    for (ForceColumns& c : force_pending) c.Clear();
+    force_pending_rows = 0;
+  }
+
+  // Never throws.
+  void CloseCsv() {
+    for (FILE*& f : csv) {
+      if (f) std::fclose(f);
+      f = nullptr;
+    }
   }
 
   void WriteEnergyRows() {
@@ -283,6 +514,8 @@ ResultsWriter::ResultsWriter(const std::string& out_dir, const std::string& name
     throw IoError("cannot create results folder '" + out_dir +
                   "': " + (ec ? ec.message() : "not a directory"));
   }
+  I.out_dir = out_dir;
+  I.dim = model.dim;
   I.h5 = (fs::path(out_dir) / (name + ".h5")).string();
   I.xmf = (fs::path(out_dir) / (name + ".xmf")).string();
   // Failures become IoError with the HDF5 message (Hdf5ErrorDetail), not a stack dump on
@@ -337,10 +570,16 @@ ResultsWriter::~ResultsWriter() {
   if (!impl_ || impl_->closed) return;
   try {
     impl_->WriteEnergyRows();
+    impl_->WriteForceRows();
   } catch (...) {
     // A destructor must not throw; the rows written so far stay in the file.
   }
   impl_->CloseHandles();
+  try {
+    impl_->WriteForceCsv();
+  } catch (...) {
+  }
+  impl_->CloseCsv();
 }
 
 void ResultsWriter::WriteSnapshot(const State& state) {
@@ -395,7 +634,9 @@ void ResultsWriter::WriteSnapshot(const State& state) {
     write_doubles("plastic_strain", I.plastic_strain, 0);
   }
   I.WriteEnergyRows();
+  I.WriteForceRows();
   I.Commit();
+  I.WriteForceCsv();
   // The .xmf lists a snapshot only once it is on disk.
   I.written.push_back(XdmfSnapshot{std::string("/snapshots/") + name, state.time, n});
   WriteXdmf(I.xmf, fs::path(I.h5).filename().string(), I.written);
@@ -411,11 +652,127 @@ void ResultsWriter::AppendEnergy(const EnergyRecord& e) {
   }
 }
 
+void ResultsWriter::BeginForces(const std::vector<ForceChannel>& channels) {
+  Impl& I = *impl_;
+  if (I.closed) throw IoError("BeginForces after Close on '" + I.h5 + "'");
+  if (I.forces_begun) throw IoError("BeginForces called twice on '" + I.h5 + "'");
+  std::set<std::string> names;
+  for (const ForceChannel& c : channels) {
+    if (!IsSafeName(c.name) || !names.insert(c.name).second)
+      throw IoError("force channel name '" + c.name + "' is empty, repeated or not [A-Za-z0-9_-]+");
+    std::set<std::string> faces;
+    for (const std::string& f : c.faces) {
+      if (!IsSafeName(f, /*allow_plus=*/true) || !faces.insert(f).second)
+        throw IoError("face name '" + f + "' of '" + c.name +
+                      "' is empty, repeated or not [A-Za-z0-9_+-]+");
+    }
+  }
+  I.forces_begun = true;
+  I.summary = ForceSummary(channels);
+  I.force_pending.assign(channels.size(), ForceColumns{});
+  for (size_t s = 0; s < channels.size(); ++s) I.force_pending[s].Resize(channels[s].faces.size());
+
+  // 2-D values are per metre of thickness (the units say so; the CSV headers keep the 3-D names).
+  const bool plane = I.dim == 2;
+  const char* force_units = plane ? "N/m" : "N";
+  const char* torque_units = plane ? "N m/m" : "N m";
+  const char* area_units = plane ? "m^2/m" : "m^2";
+  {  // groups are closed before Commit closes the file
+    Handle forces(H5Gcreate2(I.file, "forces", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    Require(forces.ok(), "create group /forces", I.h5);
+    std::vector<std::string> all;
+    for (const ForceChannel& c : channels) all.push_back(c.name);
+    WriteStringAttr(forces.get(), "structures", Join(all), I.h5);
+    for (const ForceChannel& c : channels) {
+      Handle g(H5Gcreate2(forces.get(), c.name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+               H5Gclose);
+      Require(g.ok(), "create group /forces/" + c.name, I.h5);
+      WriteStringAttr(g.get(), "faces", Join(c.faces), I.h5);
+      CreateSeries(g.get(), "time", H5T_IEEE_F64LE, 0, "s", I.h5);
+      CreateSeries(g.get(), "step", H5T_STD_I64LE, 0, "-", I.h5);
+      CreateSeries(g.get(), "dt", H5T_IEEE_F64LE, 0, "s", I.h5);
+      CreateSeries(g.get(), "force", H5T_IEEE_F64LE, 3, force_units, I.h5);
+      CreateSeries(g.get(), "torque", H5T_IEEE_F64LE, 3, torque_units, I.h5);
+      CreateSeries(g.get(), "contact_area", H5T_IEEE_F64LE, 0, area_units, I.h5);
+      CreateSeries(g.get(), "wetted_height", H5T_IEEE_F64LE, 0, "m", I.h5);
+      CreateSeries(g.get(), "max_nodal_force", H5T_IEEE_F64LE, 0, force_units, I.h5);
+      CreateSeries(g.get(), "contact_nodes", H5T_STD_I64LE, 0, "-", I.h5);
+      Handle faces(H5Gcreate2(g.get(), "faces", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      Require(faces.ok(), "create group /forces/" + c.name + "/faces", I.h5);
+      for (const std::string& f : c.faces) {
+        Handle fg(H5Gcreate2(faces.get(), f.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                  H5Gclose);
+        Require(fg.ok(), "create group /forces/" + c.name + "/faces/" + f, I.h5);
+        CreateSeries(fg.get(), "force", H5T_IEEE_F64LE, 3, force_units, I.h5);
+        CreateSeries(fg.get(), "contact_area", H5T_IEEE_F64LE, 0, area_units, I.h5);
+        CreateSeries(fg.get(), "contact_nodes", H5T_STD_I64LE, 0, "-", I.h5);
+      }
+    }
+  }
+  I.Commit();
+
+  for (const ForceChannel& c : channels) {
+    const std::string path = forces_csv_path(c.name);
+    FILE* f = std::fopen(path.c_str(), "w");
+    if (!f) throw IoError("cannot create '" + path + "': " + std::strerror(errno));
+    I.csv.push_back(f);
+    I.csv_paths.push_back(path);
+    std::string header =
+        "time_s,step,dt_s,fx_N,fy_N,fz_N,tx_Nm,ty_Nm,tz_Nm,contact_area_m2,wetted_height_m,"
+        "max_nodal_force_N,contact_nodes";
+    for (const std::string& face : c.faces) {
+      for (const char* column :
+           {"_fx_N", "_fy_N", "_fz_N", "_contact_area_m2", "_contact_nodes"})
+        header += "," + face + column;
+    }
+    header += '\n';
+    if (std::fputs(header.c_str(), f) == EOF || std::fflush(f) != 0)
+      throw IoError("cannot write '" + path + "'");
+  }
+}
+
+void ResultsWriter::AppendForces(Real time, int64_t step, Real dt, const ContactReport& report) {
+  Impl& I = *impl_;
+  if (I.closed) throw IoError("AppendForces after Close on '" + I.h5 + "'");
+  if (!I.forces_begun) {
+    if (report.structures.empty()) return;  // nothing to log, BeginForces may be skipped
+    throw IoError("AppendForces before BeginForces on '" + I.h5 + "'");
+  }
+  I.summary.Add(time, dt, report);  // checks the report's shape first
+  for (size_t s = 0; s < report.structures.size(); ++s)
+    I.force_pending[s].Push(time, step, dt, report.structures[s]);
+  ++I.force_pending_rows;
+  if (I.force_pending_rows >= kForceFlushRows) {
+    I.WriteForceRows();
+    I.Commit();
+    I.WriteForceCsv();
+  }
+}
+
 void ResultsWriter::Close(const StageSeconds& stage_seconds, int64_t steps, double wall_seconds,
                           const std::string& exit_status) {
   Impl& I = *impl_;
   if (I.closed) return;
   I.WriteEnergyRows();
+  I.WriteForceRows();
+  if (I.forces_begun) {  // the peak/impulse summary as attributes of the force groups
+    const std::vector<ForceChannel>& channels = I.summary.channels();
+    for (size_t s = 0; s < channels.size(); ++s) {
+      const std::string group = "/forces/" + channels[s].name;
+      Handle g(H5Gopen2(I.file, group.c_str(), H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "open group " + group, I.h5);
+      const StructurePeak& peak = I.summary.structure(s);
+      WritePeakAttrs(g.get(), peak, I.h5);
+      WriteScalarAttr(g.get(), "peak_wetted_height", H5T_NATIVE_DOUBLE, peak.peak_wetted_height,
+                      I.h5);
+      for (size_t f = 0; f < channels[s].faces.size(); ++f) {
+        const std::string face = "faces/" + channels[s].faces[f];
+        Handle fg(H5Gopen2(g.get(), face.c_str(), H5P_DEFAULT), H5Gclose);
+        Require(fg.ok(), "open group " + group + "/" + face, I.h5);
+        WritePeakAttrs(fg.get(), peak.faces[f], I.h5);
+      }
+    }
+  }
   {
     Handle g(H5Gcreate2(I.file, "timing", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     Require(g.ok(), "create group /timing", I.h5);
@@ -427,10 +784,16 @@ void ResultsWriter::Close(const StageSeconds& stage_seconds, int64_t steps, doub
   }
   I.closed = true;
   I.CloseHandles();
+  I.WriteForceCsv();
+  I.CloseCsv();
 }
 
 std::string ResultsWriter::h5_path() const { return impl_->h5; }
 std::string ResultsWriter::xmf_path() const { return impl_->xmf; }
 int ResultsWriter::snapshot_count() const { return int(impl_->written.size()); }
+std::string ResultsWriter::forces_csv_path(const std::string& structure) const {
+  return (fs::path(impl_->out_dir) / ("forces_" + structure + ".csv")).string();
+}
+const ForceSummary& ResultsWriter::force_summary() const { return impl_->summary; }
 
 }  // namespace surge

@@ -1,12 +1,16 @@
-// Results of one run (DESIGN §7): <out>/<name>.h5 with run metadata, particle snapshots and the
-// energy series, plus <out>/<name>.xmf so ParaView opens the HDF5 directly. HDF5 stays in
-// hdf5_writer.cpp (pimpl). Layout: docs/results-format.md.
+// Results of one run (DESIGN §7): <out>/<name>.h5 with run metadata, particle snapshots, the
+// energy series and the per-step force series (/forces, and <out>/forces_<structure>.csv), plus
+// <out>/<name>.xmf so ParaView opens the HDF5 directly. HDF5 stays in hdf5_writer.cpp (pimpl).
+// Layout: docs/results-format.md.
 #pragma once
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "contact/contact_report.h"
+#include "contact/force_summary.h"
 #include "core/model.h"
 #include "core/stage.h"
 #include "core/state.h"
@@ -44,13 +48,30 @@ class ResultsWriter {
   void WriteSnapshot(const State& state);
   // Buffered; written at each snapshot and on Close.
   void AppendEnergy(const EnergyRecord& e);
-  // Writes stage timings and the exit status, then closes the file.
+  // Starts the force series: creates /forces/<name>/... in the .h5 and truncates and heads
+  // <out>/forces_<name>.csv for every channel. Call once, before the first AppendForces; may be
+  // skipped when there are no channels. Throws IoError for a second call, a structure name
+  // outside [A-Za-z0-9_-]+, a face name outside [A-Za-z0-9_+-]+, a repeated name, and when a CSV
+  // file cannot be created.
+  void BeginForces(const std::vector<ForceChannel>& channels);
+  // One row per structure: the forces of the step of length dt [s] that ended at `time` [s]
+  // (state.time and state.dt after Step). Buffered; the rows reach the .h5 and the CSV files
+  // (each flushed) at each WriteSnapshot, whenever 1000 rows are pending, and on Close; the
+  // peak/impulse summary (ForceSummary) is updated at once and written on Close.
+  // Pre: BeginForces was called; report has the channels' shape (else std::logic_error).
+  void AppendForces(Real time, int64_t step, Real dt, const ContactReport& report);
+  // Writes the pending rows, the force summary, stage timings and the exit status, then closes
+  // the files.
   void Close(const StageSeconds& stage_seconds, int64_t steps, double wall_seconds,
              const std::string& exit_status);
 
   std::string h5_path() const;
   std::string xmf_path() const;
   int snapshot_count() const;
+  // <out>/forces_<structure>.csv (whether or not it exists).
+  std::string forces_csv_path(const std::string& structure) const;
+  // Peaks and impulses of every row appended so far (empty before BeginForces).
+  const ForceSummary& force_summary() const;
 
  private:
   struct Impl;

@@ -1,5 +1,6 @@
 // ResultsWriter: layout, values, verbatim scene text, energy rows, timing, XDMF, crash safety
-// (a child process killed after or during a snapshot), errors; StrainInvariants.
+// (a child process killed after or during a snapshot), errors; force series (HDF5 and CSV, flush
+// cadence, kill, summary attributes); StrainInvariants.
 #include "io/results_writer.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -26,6 +28,8 @@ namespace fs = std::filesystem;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 // Energy rows the writer buffers before writing them without a snapshot (hdf5_writer.cpp).
 constexpr size_t kFlushRows = 1024;
+// Force rows likewise (the cadence promised in results_writer.h).
+constexpr size_t kForceFlushRows = 1000;
 
 Model TinyModel(int dim = 3) {
   Model m;
@@ -421,6 +425,392 @@ TEST_F(ResultsWriterTest, UncreatableFileNamesThePathAndCause) {
     EXPECT_NE(what.find((dir_ / "x.h5").string()), std::string::npos) << what;
     EXPECT_NE(what.find("("), std::string::npos) << "HDF5's reason is appended: " << what;
   }
+}
+
+// --- Force series ---
+
+std::vector<ForceChannel> ForceChannels() {
+  return {ForceChannel{"domain", {"x-", "x+", "y-", "y+", "z-", "z+"}},
+          ForceChannel{"pier-1", {"front", "back"}}};
+}
+
+// Row r of a synthetic series: values with full mantissas, both signs and magnitudes from 1e-100
+// to 1e100 (the CSV must round-trip them; |F|^2 stays finite), steps beyond 2^32.
+struct ForceRow {
+  Real time = 0;
+  int64_t step = 0;
+  Real dt = 0;
+  ContactReport report;
+};
+
+Real Synthetic(size_t r, size_t s, int k) {
+  const Real scale = std::pow(10.0, double(int(r % 9) * 25 - 100) * (k % 3 == 0 ? 1 : 0));
+  return std::sin(0.37 * double(r) + 1.1 * double(s) + 0.13 * k) * 1e3 / 3 * scale;
+}
+
+std::vector<ForceRow> ForceRows(const std::vector<ForceChannel>& channels, size_t n) {
+  std::vector<ForceRow> rows(n);
+  Real time = 0;
+  for (size_t r = 0; r < n; ++r) {
+    ForceRow& row = rows[r];
+    row.dt = 1e-4 * (1 + 0.01 * std::sin(double(r)));
+    time += row.dt;
+    row.time = time;
+    row.step = int64_t(r) + 1 + 10000000000;
+    for (size_t s = 0; s < channels.size(); ++s) {
+      ObstacleForce o;
+      o.force = Vec3(Synthetic(r, s, 0), Synthetic(r, s, 1), Synthetic(r, s, 2));
+      o.torque = Vec3(Synthetic(r, s, 3), Synthetic(r, s, 4), Synthetic(r, s, 5));
+      o.contact_area = std::abs(Synthetic(r, s, 7));
+      o.wetted_height = std::abs(Synthetic(r, s, 8));
+      o.max_nodal_force = std::abs(Synthetic(r, s, 10));
+      o.contact_nodes = int64_t(7 * r + s);
+      for (size_t f = 0; f < channels[s].faces.size(); ++f) {
+        const int k = 20 + 5 * int(f);
+        o.faces.push_back(
+            FaceForce{Vec3(Synthetic(r, s, k), Synthetic(r, s, k + 1), Synthetic(r, s, k + 2)),
+                      std::abs(Synthetic(r, s, k + 4)), int64_t(3 * r + f)});
+      }
+      row.report.structures.push_back(o);
+    }
+  }
+  return rows;
+}
+
+std::vector<std::string> ReadLines(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> Split(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream in(line);
+  for (std::string field; std::getline(in, field, ',');) fields.push_back(field);
+  return fields;
+}
+
+// Every value of rows[0, n) is in /forces of `f` exactly.
+void ExpectForcesInHdf5(hid_t f, const std::vector<ForceChannel>& channels,
+                        const std::vector<ForceRow>& rows, size_t n) {
+  for (size_t s = 0; s < channels.size(); ++s) {
+    const std::string g = "/forces/" + channels[s].name + "/";
+    SCOPED_TRACE(g);
+    EXPECT_EQ(Dims(f, g + "time"), (std::vector<hsize_t>{n}));
+    EXPECT_EQ(Dims(f, g + "force"), (std::vector<hsize_t>{n, 3}));
+    EXPECT_EQ(Dims(f, g + "torque"), (std::vector<hsize_t>{n, 3}));
+    const auto time = ReadDoubles(f, g + "time");
+    const auto step = Read<int64_t>(f, g + "step", H5T_NATIVE_INT64);
+    const auto dt = ReadDoubles(f, g + "dt");
+    const auto force = ReadDoubles(f, g + "force");
+    const auto torque = ReadDoubles(f, g + "torque");
+    const auto area = ReadDoubles(f, g + "contact_area");
+    const auto height = ReadDoubles(f, g + "wetted_height");
+    const auto max_nodal = ReadDoubles(f, g + "max_nodal_force");
+    const auto nodes = Read<int64_t>(f, g + "contact_nodes", H5T_NATIVE_INT64);
+    ASSERT_EQ(time.size(), n);
+    ASSERT_EQ(step.size(), n);
+    ASSERT_EQ(dt.size(), n);
+    ASSERT_EQ(force.size(), 3 * n);
+    ASSERT_EQ(torque.size(), 3 * n);
+    ASSERT_EQ(area.size(), n);
+    ASSERT_EQ(height.size(), n);
+    ASSERT_EQ(max_nodal.size(), n);
+    ASSERT_EQ(nodes.size(), n);
+    for (size_t r = 0; r < n; ++r) {
+      const ObstacleForce& o = rows[r].report.structures[s];
+      ASSERT_EQ(time[r], rows[r].time) << r;
+      ASSERT_EQ(step[r], rows[r].step) << r;
+      ASSERT_EQ(dt[r], rows[r].dt) << r;
+      for (int d = 0; d < 3; ++d) {
+        ASSERT_EQ(force[3 * r + d], o.force[d]) << r;
+        ASSERT_EQ(torque[3 * r + d], o.torque[d]) << r;
+      }
+      ASSERT_EQ(area[r], o.contact_area) << r;
+      ASSERT_EQ(height[r], o.wetted_height) << r;
+      ASSERT_EQ(max_nodal[r], o.max_nodal_force) << r;
+      ASSERT_EQ(nodes[r], o.contact_nodes) << r;
+    }
+    for (size_t k = 0; k < channels[s].faces.size(); ++k) {
+      const std::string fg = g + "faces/" + channels[s].faces[k] + "/";
+      const auto face_force = ReadDoubles(f, fg + "force");
+      const auto face_area = ReadDoubles(f, fg + "contact_area");
+      const auto face_nodes = Read<int64_t>(f, fg + "contact_nodes", H5T_NATIVE_INT64);
+      EXPECT_EQ(Dims(f, fg + "force"), (std::vector<hsize_t>{n, 3})) << fg;
+      ASSERT_EQ(face_area.size(), n) << fg;
+      ASSERT_EQ(face_nodes.size(), n) << fg;
+      for (size_t r = 0; r < n; ++r) {
+        const FaceForce& face = rows[r].report.structures[s].faces[k];
+        for (int d = 0; d < 3; ++d) ASSERT_EQ(face_force[3 * r + d], face.force[d]) << fg << r;
+        ASSERT_EQ(face_area[r], face.contact_area) << fg << r;
+        ASSERT_EQ(face_nodes[r], face.contact_nodes) << fg << r;
+      }
+    }
+  }
+}
+
+// The CSV of structure s holds the header and exactly rows[0, n), every value round-tripped.
+void ExpectForcesInCsv(const fs::path& csv, const ForceChannel& channel, size_t s,
+                       const std::vector<ForceRow>& rows, size_t n) {
+  SCOPED_TRACE(csv.string());
+  const std::vector<std::string> lines = ReadLines(csv);
+  ASSERT_EQ(lines.size(), n + 1);
+  std::string header =
+      "time_s,step,dt_s,fx_N,fy_N,fz_N,tx_Nm,ty_Nm,tz_Nm,contact_area_m2,wetted_height_m,"
+      "max_nodal_force_N,contact_nodes";
+  for (const std::string& face : channel.faces)
+    header += "," + face + "_fx_N," + face + "_fy_N," + face + "_fz_N," + face +
+              "_contact_area_m2," + face + "_contact_nodes";
+  EXPECT_EQ(lines[0], header);
+  for (size_t r = 0; r < n; ++r) {
+    const std::vector<std::string> field = Split(lines[r + 1]);
+    ASSERT_EQ(field.size(), 13 + 5 * channel.faces.size()) << r;
+    const auto real = [&](size_t i) { return std::strtod(field[i].c_str(), nullptr); };
+    const auto integer = [&](size_t i) {
+      return int64_t(std::strtoll(field[i].c_str(), nullptr, 10));
+    };
+    const ObstacleForce& o = rows[r].report.structures[s];
+    ASSERT_EQ(real(0), rows[r].time) << r;
+    ASSERT_EQ(integer(1), rows[r].step) << r;
+    ASSERT_EQ(real(2), rows[r].dt) << r;
+    for (int d = 0; d < 3; ++d) {
+      ASSERT_EQ(real(3 + d), o.force[d]) << r;
+      ASSERT_EQ(real(6 + d), o.torque[d]) << r;
+    }
+    ASSERT_EQ(real(9), o.contact_area) << r;
+    ASSERT_EQ(real(10), o.wetted_height) << r;
+    ASSERT_EQ(real(11), o.max_nodal_force) << r;
+    ASSERT_EQ(integer(12), o.contact_nodes) << r;
+    for (size_t k = 0; k < channel.faces.size(); ++k) {
+      const size_t at = 13 + 5 * k;
+      for (int d = 0; d < 3; ++d) ASSERT_EQ(real(at + d), o.faces[k].force[d]) << r;
+      ASSERT_EQ(real(at + 3), o.faces[k].contact_area) << r;
+      ASSERT_EQ(integer(at + 4), o.faces[k].contact_nodes) << r;
+    }
+  }
+}
+
+// Peak attributes of one force group against the series itself (first maximum of |F|, sum F dt).
+void ExpectPeakAttrs(hid_t group, const std::vector<Vec3>& force,
+                     const std::vector<ForceRow>& rows) {
+  size_t peak = 0;
+  Vec3 impulse = Vec3::Zero();
+  for (size_t r = 0; r < force.size(); ++r) {
+    if (force[r].norm() > force[peak].norm()) peak = r;
+    for (int d = 0; d < 3; ++d) impulse[d] += force[r][d] * rows[r].dt;
+  }
+  EXPECT_EQ(ReadAttr<double>(group, "peak_force", H5T_NATIVE_DOUBLE), force[peak].norm());
+  EXPECT_EQ(ReadAttr<double>(group, "peak_time", H5T_NATIVE_DOUBLE), rows[peak].time);
+  for (const char* name : {"impulse", "force_at_peak"}) {
+    double v[3] = {0, 0, 0};
+    const hid_t attr = H5Aopen(group, name, H5P_DEFAULT);
+    ASSERT_GE(attr, 0) << name;
+    EXPECT_GE(H5Aread(attr, H5T_NATIVE_DOUBLE, v), 0);
+    H5Aclose(attr);
+    const Vec3 expected = std::string(name) == "impulse" ? impulse : force[peak];
+    for (int d = 0; d < 3; ++d) EXPECT_EQ(v[d], expected[d]) << name << d;
+  }
+}
+
+TEST_F(ResultsWriterTest, ForceSeriesReadBackExactlyFromHdf5AndCsv) {
+  const auto channels = ForceChannels();
+  const size_t n = 300;
+  const auto rows = ForceRows(channels, n);
+  fs::path h5;
+  {
+    ResultsWriter w(dir_.string(), "forces", RunMetadata{}, TinyModel());
+    w.BeginForces(channels);
+    EXPECT_EQ(ReadLines(w.forces_csv_path("domain")).size(), 1u) << "the header is on disk";
+    for (size_t r = 0; r < 140; ++r)
+      w.AppendForces(rows[r].time, rows[r].step, rows[r].dt, rows[r].report);
+    EXPECT_EQ(ReadLines(w.forces_csv_path("pier-1")).size(), 1u) << "rows are buffered";
+    w.WriteSnapshot(TinyState(2));
+    EXPECT_EQ(ReadLines(w.forces_csv_path("pier-1")).size(), 141u) << "a snapshot flushes them";
+    for (size_t r = 140; r < n; ++r)
+      w.AppendForces(rows[r].time, rows[r].step, rows[r].dt, rows[r].report);
+    EXPECT_EQ(w.forces_csv_path("pier-1"), (dir_ / "forces_pier-1.csv").string());
+    EXPECT_EQ(w.force_summary().samples(), int64_t(n));
+    w.Close(StageSeconds{}, int64_t(n), 0, "completed");
+    h5 = w.h5_path();
+  }
+  hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  ExpectForcesInHdf5(f, channels, rows, n);
+
+  // Names, units and the peak/impulse attributes.
+  hid_t forces = H5Gopen2(f, "/forces", H5P_DEFAULT);
+  ASSERT_GE(forces, 0);
+  EXPECT_EQ(ReadStringAttr(forces, "structures"), "domain,pier-1");
+  H5Gclose(forces);
+  for (size_t s = 0; s < channels.size(); ++s) {
+    const std::string g = "/forces/" + channels[s].name;
+    hid_t group = H5Gopen2(f, g.c_str(), H5P_DEFAULT);
+    ASSERT_GE(group, 0) << g;
+    EXPECT_EQ(ReadStringAttr(group, "faces"), s == 0 ? "x-,x+,y-,y+,z-,z+" : "front,back");
+    std::vector<Vec3> force;
+    Real peak_height = 0;
+    for (const ForceRow& row : rows) {
+      force.push_back(row.report.structures[s].force);
+      peak_height = std::max(peak_height, row.report.structures[s].wetted_height);
+    }
+    ExpectPeakAttrs(group, force, rows);
+    EXPECT_EQ(ReadAttr<double>(group, "peak_wetted_height", H5T_NATIVE_DOUBLE), peak_height);
+    for (size_t k = 0; k < channels[s].faces.size(); ++k) {
+      const std::string fg = "faces/" + channels[s].faces[k];
+      hid_t face = H5Gopen2(group, fg.c_str(), H5P_DEFAULT);
+      ASSERT_GE(face, 0) << fg;
+      std::vector<Vec3> face_force;
+      for (const ForceRow& row : rows)
+        face_force.push_back(row.report.structures[s].faces[k].force);
+      ExpectPeakAttrs(face, face_force, rows);
+      H5Gclose(face);
+    }
+    H5Gclose(group);
+  }
+  const std::pair<const char*, const char*> units[] = {{"time", "s"},
+                                                       {"step", "-"},
+                                                       {"dt", "s"},
+                                                       {"force", "N"},
+                                                       {"torque", "N m"},
+                                                       {"contact_area", "m^2"},
+                                                       {"wetted_height", "m"},
+                                                       {"max_nodal_force", "N"},
+                                                       {"contact_nodes", "-"},
+                                                       {"faces/front/force", "N"},
+                                                       {"faces/front/contact_area", "m^2"}};
+  for (const auto& [name, unit] : units) {
+    hid_t ds = H5Dopen2(f, (std::string("/forces/pier-1/") + name).c_str(), H5P_DEFAULT);
+    ASSERT_GE(ds, 0) << name;
+    EXPECT_EQ(ReadStringAttr(ds, "units"), unit) << name;
+    H5Dclose(ds);
+  }
+  H5Fclose(f);
+
+  for (size_t s = 0; s < channels.size(); ++s)
+    ExpectForcesInCsv(dir_ / ("forces_" + channels[s].name + ".csv"), channels[s], s, rows, n);
+}
+
+TEST_F(ResultsWriterTest, ForceRowsAreFlushedEvery1000Rows) {
+  const std::vector<ForceChannel> channels = {ForceChannel{"gate", {"upstream"}}};
+  const auto rows = ForceRows(channels, 2 * kForceFlushRows + 5);
+  ResultsWriter w(dir_.string(), "cadence", RunMetadata{}, TinyModel());
+  w.BeginForces(channels);
+  const fs::path csv = w.forces_csv_path("gate");
+  size_t r = 0;
+  const auto append = [&](size_t count) {
+    for (size_t end = r + count; r < end; ++r)
+      w.AppendForces(rows[r].time, rows[r].step, rows[r].dt, rows[r].report);
+  };
+  append(kForceFlushRows - 1);
+  EXPECT_EQ(ReadLines(csv).size(), 1u);
+  append(1);
+  EXPECT_EQ(ReadLines(csv).size(), 1 + kForceFlushRows);
+  append(kForceFlushRows - 1);
+  EXPECT_EQ(ReadLines(csv).size(), 1 + kForceFlushRows);
+  append(1);
+  EXPECT_EQ(ReadLines(csv).size(), 1 + 2 * kForceFlushRows);
+  append(5);
+  w.Close(StageSeconds{}, 0, 0, "completed");
+  ExpectForcesInCsv(csv, channels[0], 0, rows, rows.size());
+  hid_t f = H5Fopen(w.h5_path().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  ExpectForcesInHdf5(f, channels, rows, rows.size());
+  H5Fclose(f);
+}
+
+// The child appends, snapshots and is killed without Close or destructors (_exit): the .h5 and
+// the CSV hold every row up to the last flush (1000 rows on their own, then 100 more with the
+// snapshot), and nothing after it.
+TEST_F(ResultsWriterTest, KilledRunKeepsForceRowsUpToTheLastFlush) {
+  const auto channels = ForceChannels();
+  const auto rows = ForceRows(channels, 1350);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ResultsWriter w(dir_.string(), "killed", RunMetadata{}, TinyModel());
+    w.BeginForces(channels);
+    for (size_t r = 0; r < rows.size(); ++r) {
+      w.AppendForces(rows[r].time, rows[r].step, rows[r].dt, rows[r].report);
+      if (r + 1 == 1100) w.WriteSnapshot(TinyState(3));
+    }
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  hid_t f = H5Fopen((dir_ / "killed.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << "the file of a killed run must stay readable";
+  ExpectForcesInHdf5(f, channels, rows, 1100);
+  EXPECT_EQ(H5Aexists_by_name(f, "/forces/domain", "peak_force", H5P_DEFAULT), 0)
+      << "the summary is written on Close only";
+  H5Fclose(f);
+  for (size_t s = 0; s < channels.size(); ++s)
+    ExpectForcesInCsv(dir_ / ("forces_" + channels[s].name + ".csv"), channels[s], s, rows, 1100);
+}
+
+TEST_F(ResultsWriterTest, DestructorWithoutCloseWritesPendingForceRows) {
+  const std::vector<ForceChannel> channels = {ForceChannel{"gate", {}}};
+  const auto rows = ForceRows(channels, 7);
+  {
+    ResultsWriter w(dir_.string(), "unclosed", RunMetadata{}, TinyModel());
+    w.BeginForces(channels);
+    for (const ForceRow& row : rows) w.AppendForces(row.time, row.step, row.dt, row.report);
+  }
+  hid_t f = H5Fopen((dir_ / "unclosed.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  ExpectForcesInHdf5(f, channels, rows, rows.size());
+  H5Fclose(f);
+  ExpectForcesInCsv(dir_ / "forces_gate.csv", channels[0], 0, rows, rows.size());
+}
+
+TEST_F(ResultsWriterTest, PlaneRunsLabelForcesPerMetre) {
+  {
+    ResultsWriter w(dir_.string(), "plane", RunMetadata{}, TinyModel(/*dim=*/2));
+    w.BeginForces({ForceChannel{"gate", {"upstream"}}});
+    w.Close(StageSeconds{}, 0, 0, "completed");
+  }
+  hid_t f = H5Fopen((dir_ / "plane.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  const std::pair<const char*, const char*> units[] = {{"force", "N/m"},
+                                                       {"torque", "N m/m"},
+                                                       {"contact_area", "m^2/m"},
+                                                       {"wetted_height", "m"},
+                                                       {"faces/upstream/force", "N/m"}};
+  for (const auto& [name, unit] : units) {
+    hid_t ds = H5Dopen2(f, (std::string("/forces/gate/") + name).c_str(), H5P_DEFAULT);
+    ASSERT_GE(ds, 0) << name;
+    EXPECT_EQ(ReadStringAttr(ds, "units"), unit) << name;
+    H5Dclose(ds);
+  }
+  EXPECT_EQ(Dims(f, "/forces/gate/time"), (std::vector<hsize_t>{0}));
+  hid_t g = H5Gopen2(f, "/forces/gate", H5P_DEFAULT);
+  ASSERT_GE(g, 0);
+  EXPECT_TRUE(std::isnan(ReadAttr<double>(g, "peak_time", H5T_NATIVE_DOUBLE))) << "no rows";
+  H5Gclose(g);
+  H5Fclose(f);
+}
+
+TEST_F(ResultsWriterTest, ForceSeriesMisuseThrows) {
+  ResultsWriter w(dir_.string(), "misuse", RunMetadata{}, TinyModel());
+  const auto channels = ForceChannels();
+  const auto rows = ForceRows(channels, 1);
+  EXPECT_THROW(w.AppendForces(0, 1, 1, rows[0].report), IoError) << "before BeginForces";
+  w.AppendForces(0, 1, 1, ContactReport{});  // no channels: nothing to log, no BeginForces needed
+  EXPECT_THROW(w.BeginForces({ForceChannel{"a/b", {}}}), IoError);
+  EXPECT_THROW(w.BeginForces({ForceChannel{"", {}}}), IoError);
+  EXPECT_THROW(w.BeginForces({ForceChannel{"a", {}}, ForceChannel{"a", {}}}), IoError);
+  EXPECT_THROW(w.BeginForces({ForceChannel{"a", {"x+", "x+"}}}), IoError);
+  EXPECT_THROW(w.BeginForces({ForceChannel{"a", {"top face"}}}), IoError);
+  w.BeginForces(channels);  // the rejected calls left nothing behind
+  EXPECT_THROW(w.BeginForces(channels), IoError) << "twice";
+  ContactReport wrong = rows[0].report;
+  wrong.structures.pop_back();
+  EXPECT_THROW(w.AppendForces(0, 1, 1, wrong), std::logic_error);
+  w.AppendForces(rows[0].time, rows[0].step, rows[0].dt, rows[0].report);
+  w.Close(StageSeconds{}, 1, 0, "completed");
+  EXPECT_THROW(w.AppendForces(0, 1, 1, rows[0].report), IoError);
+  ExpectForcesInCsv(dir_ / "forces_domain.csv", channels[0], 0, rows, 1);
 }
 
 TEST(StrainInvariantsTest, IdentityIsUnstrained) {
