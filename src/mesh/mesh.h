@@ -12,6 +12,10 @@ namespace surge {
 struct TriangleMesh {
   std::vector<Vec3> vertices;                // [m] (after any scaling by the caller)
   std::vector<std::array<int, 3>> triangles; // indices into `vertices`, counter-clockwise outward
+  // Mesh parts (CAD objects/groups), so that forces on a mesh obstacle can be grouped by part.
+  // Either empty (the whole mesh is one part) or one entry per triangle: an index into part_names.
+  std::vector<int> part;
+  std::vector<std::string> part_names;  // unique names; "part<k>" where the file has none
 };
 
 struct Aabb {
@@ -20,7 +24,10 @@ struct Aabb {
 };
 
 // Reads every triangle of every mesh in `path` (STL ascii/binary, OBJ, PLY, glTF, ... whatever
-// assimp recognises), with node transforms applied and identical vertices merged.
+// assimp recognises), with node transforms applied and identical vertices merged. Each named
+// assimp mesh (OBJ `o`/`g` group, glTF mesh, STL solid) becomes a part; meshes with the same name
+// share one part, unnamed ones are called "part<k>" (k = the part's index). part/part_names are
+// always filled.
 // Throws std::runtime_error naming the file if it cannot be read or holds no triangles.
 TriangleMesh ReadTriangleMesh(const std::string& path);
 

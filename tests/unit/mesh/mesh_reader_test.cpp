@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mesh/mesh.h"
 
@@ -22,10 +23,33 @@ void ExpectUnitCube(const TriangleMesh& mesh) {
   EXPECT_EQ(box.max, Vec3(1, 1, 1));
 }
 
-TEST(ReadTriangleMeshTest, ReadsObjCube) { ExpectUnitCube(ReadTriangleMesh(Data("unit_cube.obj"))); }
+TEST(ReadTriangleMeshTest, ReadsObjCube) {
+  const TriangleMesh mesh = ReadTriangleMesh(Data("unit_cube.obj"));
+  ExpectUnitCube(mesh);
+  ASSERT_EQ(mesh.part_names.size(), 1u);  // no groups: one part
+  EXPECT_EQ(mesh.part, std::vector<int>(12, 0));
+}
+
+TEST(ReadTriangleMeshTest, ObjGroupsBecomeParts) {
+  const TriangleMesh mesh = ReadTriangleMesh(Data("two_parts.obj"));
+  ExpectUnitCube(mesh);  // the parts share their rim vertices: still closed
+  ASSERT_EQ(mesh.part_names, (std::vector<std::string>{"body", "lid"}));
+  ASSERT_EQ(mesh.part.size(), mesh.triangles.size());
+  int lid = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    bool on_top = true;
+    for (const int v : mesh.triangles[t]) on_top = on_top && mesh.vertices[v].z() == 1.0;
+    EXPECT_EQ(mesh.part[t], on_top ? 1 : 0) << "triangle " << t;
+    lid += mesh.part[t] == 1;
+  }
+  EXPECT_EQ(lid, 2);
+}
 
 TEST(ReadTriangleMeshTest, ReadsAsciiStlCube) {
-  ExpectUnitCube(ReadTriangleMesh(Data("unit_cube.stl")));
+  const TriangleMesh mesh = ReadTriangleMesh(Data("unit_cube.stl"));
+  ExpectUnitCube(mesh);
+  ASSERT_EQ(mesh.part_names.size(), 1u);
+  EXPECT_EQ(mesh.part.size(), mesh.triangles.size());
 }
 
 TEST(ReadTriangleMeshTest, MissingFileThrowsNamingIt) {
