@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -129,6 +130,10 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   };
 
   if (model.output.energy) writer.AppendEnergy(ComputeEnergy(model, state));
+  // Reaction forces on the domain walls and every obstacle, logged every step (DESIGN §7).
+  const std::vector<ForceChannel> channels = ForceChannels(model);
+  if (!channels.empty()) writer.BeginForces(channels);
+  ContactReport forces;
   write_snapshot();
   Real next_output = model.output.every > 0 ? model.output.every : model.time.end;
   const auto start = std::chrono::steady_clock::now();
@@ -150,12 +155,9 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
     }
     particle_steps += double(n);
     if (model.output.energy) writer.AppendEnergy(report.energy);
-    for (int f = 0; f < kFaceCount; ++f) {
-      const Real r = report.walls.force[f].norm();
-      if (r > summary.peak_wall_force[f]) {
-        summary.peak_wall_force[f] = r;
-        summary.peak_wall_time[f] = state.time;
-      }
+    if (!channels.empty()) {
+      CollectForces(model, report, forces);
+      writer.AppendForces(state.time, state.step, state.dt, forces);
     }
     if (report.removed_last_step > 0)
       Log(LogLevel::kDebug, fmt::format("{} particles left the domain", report.removed_last_step));
@@ -180,6 +182,11 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   summary.steps = state.step;
   summary.end_time = state.time;
   summary.particle_updates_per_second = particle_steps / std::max(summary.wall_seconds, 1e-9);
+  summary.force_channels = channels;
+  if (!channels.empty()) {
+    const ForceSummary& fs = writer.force_summary();
+    for (size_t k = 0; k < fs.size(); ++k) summary.force_peaks.push_back(fs.structure(k));
+  }
   writer.Close(report.stage_seconds, state.step, summary.wall_seconds, summary.exit_status);
   summary.h5_path = writer.h5_path();
   summary.xmf_path = writer.xmf_path();
@@ -195,13 +202,21 @@ void PrintSummary(const LoadedScene& scene, const RunSummary& s) {
               s.particle_updates_per_second);
   std::printf("   particles %zu (removed through open sides: %lld)\n", scene.state.particles.size(),
               static_cast<long long>(scene.state.particles_removed));
-  bool any = false;
-  for (int f = 0; f < kFaceCount; ++f) {
-    if (model.walls[f].kind == WallKind::kOpen || f / 2 >= model.dim) continue;
-    if (!any) std::printf("   wall reaction forces (peak |R| over the run):\n");
-    any = true;
-    std::printf("     %-3s peak %12.5g N at t = %.4g s\n", FaceName(Face(f)), s.peak_wall_force[f],
-                s.peak_wall_time[f]);
+  // Force summary: peak |F| (every step counted, seed spec §5.4) and impulse per structure and
+  // per face with any load.
+  if (!s.force_channels.empty()) std::printf("   reaction forces on the structures (every step; 2-D: per m):\n");
+  for (size_t k = 0; k < s.force_channels.size() && k < s.force_peaks.size(); ++k) {
+    const StructurePeak& p = s.force_peaks[k];
+    const auto print = [](const std::string& label, const ForcePeak& f) {
+      std::printf("     %-22s peak |F| %12.5g N at t = %-9.4g F = (%.4g, %.4g, %.4g) N, impulse (%.4g, %.4g, %.4g) N s\n",
+                  label.c_str(), f.peak_force, std::isnan(f.peak_time) ? 0.0 : f.peak_time,
+                  f.force_at_peak.x(), f.force_at_peak.y(), f.force_at_peak.z(), f.impulse.x(),
+                  f.impulse.y(), f.impulse.z());
+    };
+    print(s.force_channels[k].name, p);
+    for (size_t f = 0; f < p.faces.size(); ++f) {
+      if (p.faces[f].peak_force > 0) print("  " + s.force_channels[k].faces[f], p.faces[f]);
+    }
   }
   std::printf("   results: %s (%d snapshots)\n            %s (open in ParaView)\n",
               s.h5_path.c_str(), s.snapshots, s.xmf_path.c_str());

@@ -3,6 +3,9 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include "contact/force_summary.h"
 
 #include "core/math.h"
 
@@ -35,8 +38,9 @@ struct RunSummary {
   double wall_seconds = 0;
   double particle_updates_per_second = 0;
   Real end_time = 0;
-  std::array<Real, 6> peak_wall_force{};  // max |R| per face over the run [N]
-  std::array<Real, 6> peak_wall_time{};   // time of that peak [s]
+  // Peak and impulse of every logged structure (domain walls, obstacles), every step counted.
+  std::vector<ForceChannel> force_channels;
+  std::vector<StructurePeak> force_peaks;  // as force_channels
   std::string h5_path, xmf_path;
   int snapshots = 0;
 };

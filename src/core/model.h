@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "contact/obstacle.h"
 #include "core/math.h"
 #include "materials/material_params.h"
 
@@ -81,6 +82,7 @@ struct Model {
   std::vector<Material> materials;
   std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none
   std::vector<BodyInfo> bodies;
+  std::vector<Obstacle> obstacles;       // rigid structures (src/contact), in scene order
   OutputPlan output;
 };
 

@@ -10,9 +10,11 @@ enum class Stage : int {
   kReorderParticles,  // every kReorderInterval steps
   kParticleToGrid,
   kGridUpdate,
+  kObstacleContact,    // only with obstacles (src/contact)
   kGridToParticle,
   kRemapMomentum,      // MUSL only
   kVelocityGradient,   // MUSL only
+  kObstacleProjection, // only with obstacles: particles inside an obstacle back to its surface
   kAntiLocking,        // only when a material is anti-locked (src/stabilize)
   kUpdateStress,
   kDomainExit,

@@ -55,7 +55,8 @@ struct SparseGrid {
   std::vector<std::vector<BlockRequest>> chunk_requests;
   std::vector<BlockRequest> requests;
   std::vector<uint32_t> chunk_cursor;
-  std::vector<std::array<Real, 19>> wall_partials;  // per-block wall reactions (grid_update.cpp)
+  using WallPartial = std::array<Real, 45>;  // 6 faces x 7 sums + 3 (grid_update.cpp)
+  std::vector<WallPartial> wall_partials;    // per-block wall reactions (grid_update.cpp)
 
   std::unique_ptr<BlockTopology> topology;
 

@@ -7,8 +7,15 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <numbers>
+#include <type_traits>
+#include <variant>
 #include <string>
 
+#include "contact/geometry.h"
+#include "contact/mesh_distance.h"
+#include "core/log.h"
 #include "materials/update_stress.h"
 #include "mesh/mesh.h"
 #include "scene/particle_sampling.h"
@@ -49,7 +56,73 @@ struct SeededBody {
   Real mass = 0;     // [kg]
 };
 
-SeededBody SeedBody(const SceneSpec& spec, size_t b) {
+std::string ObstaclePath(size_t o) { return "obstacles[" + std::to_string(o) + "]"; }
+
+// Obstacle o of the spec as the run sees it: shape (meshes read, transformed and given their
+// distance field), faces, bounds, reference point and motion.
+Obstacle BuildObstacle(const SceneSpec& spec, size_t index) {
+  const ObstacleSpec& os = spec.obstacles[index];
+  const int dim = spec.dimension;
+  Obstacle o;
+  o.name = os.name;
+  o.contact = os.contact;
+  std::visit(
+      [&](const auto& s) {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, PlaneShape>) {
+          o.shape = s;
+        } else if constexpr (std::is_same_v<S, BoxRegion>) {
+          o.shape = BoxShape{s.min, s.max};
+        } else if constexpr (std::is_same_v<S, SphereRegion>) {
+          o.shape = SphereShape{s.center, s.radius};
+        } else if constexpr (std::is_same_v<S, CylinderRegion>) {
+          o.shape = CylinderShape{s.base, s.top, s.radius};
+        } else if constexpr (std::is_same_v<S, PolygonRegion>) {
+          o.shape = PolygonShape{s.points, s.z0, s.z1};
+        } else {
+          const std::string path = ObstaclePath(index) + ".shape.mesh.file";
+          TriangleMesh mesh;
+          try {
+            mesh = ReadTriangleMesh(s.file);
+          } catch (const std::exception& e) {
+            Fail(s.file_loc, path, e.what());
+          }
+          // x' = R (scale x) + t with R = Rz Ry Rx (rotate about x, then y, then z).
+          constexpr Real kDeg = std::numbers::pi / 180.0;
+          const Mat3 R = (Eigen::AngleAxis<Real>(s.rotate_deg.z() * kDeg, Vec3::UnitZ()) *
+                          Eigen::AngleAxis<Real>(s.rotate_deg.y() * kDeg, Vec3::UnitY()) *
+                          Eigen::AngleAxis<Real>(s.rotate_deg.x() * kDeg, Vec3::UnitX()))
+                             .toRotationMatrix();
+          for (Vec3& v : mesh.vertices) v = R * (s.scale * v) + s.translate;
+          MeshShape shape;
+          shape.file = s.file;
+          try {
+            shape.field = std::make_shared<const MeshDistanceField>(std::move(mesh), s.one_sided);
+          } catch (const std::exception& e) {
+            Fail(s.file_loc, path, "mesh '" + s.file + "': " + e.what());
+          }
+          o.shape = std::move(shape);
+        }
+      },
+      os.shape);
+  o.faces = FaceNames(o.shape, dim);
+  ReferenceBounds(o.shape, dim, o.bounds_min, o.bounds_max);
+  if (os.reference_point) {
+    o.reference_point = *os.reference_point;
+  } else if (const auto* plane = std::get_if<PlaneShape>(&o.shape)) {
+    o.reference_point = plane->point;
+  } else {
+    o.reference_point = 0.5 * (o.bounds_min + o.bounds_max);
+    if (dim == 2) o.reference_point.z() = 0;
+  }
+  o.motion.kind = os.motion;
+  o.motion.velocity = os.velocity;
+  o.motion.angular_velocity = os.angular_velocity_deg * (std::numbers::pi / 180.0);
+  o.motion.center = os.center ? *os.center : o.reference_point;
+  return o;
+}
+
+SeededBody SeedBody(const SceneSpec& spec, size_t b, const std::vector<Obstacle>& obstacles) {
   const BodySpec& body = spec.bodies[b];
   const MaterialSpec& material = spec.materials[body.material_index];
   const int dim = spec.dimension;
@@ -92,6 +165,25 @@ SeededBody SeedBody(const SceneSpec& spec, size_t b) {
              " m (cell_size / particles_per_cell); it may be thinner than one spacing");
   }
   JitterPositions(dim, s, body.jitter, body.seed, out.x);
+  // Carve the obstacles out of the body: a region drawn through a column or below a terrain
+  // mesh keeps only the particles outside every obstacle.
+  if (!obstacles.empty()) {
+    const size_t before = out.x.size();
+    std::erase_if(out.x, [&](const Vec3& x) {
+      for (const Obstacle& o : obstacles) {
+        if (QueryObstacle(o, PoseAt(o, 0), x, dim, 0, spec.grid.cell_size).distance < 0) return true;
+      }
+      return false;
+    });
+    if (out.x.size() < before) {
+      LogInfo("body '" + body.name + "': " + std::to_string(before - out.x.size()) +
+              " particles inside obstacles were not seeded");
+    }
+    if (out.x.empty()) {
+      Fail(body.region_loc, path + ".region",
+           "every particle of body '" + body.name + "' lies inside an obstacle");
+    }
+  }
 
   for (const Vec3& x : out.x) {
     for (int a = 0; a < dim; ++a) {
@@ -174,6 +266,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
     model.antilocking.push_back(ResolvedAntiLocking(m));
   }
   for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
+  for (size_t o = 0; o < spec.obstacles.size(); ++o) model.obstacles.push_back(BuildObstacle(spec, o));
   model.output.every = spec.output.every;
   model.output.vdb = spec.output.vdb;
   model.output.energy = spec.output.energy;
@@ -184,7 +277,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   double total = 0;
   for (size_t b = 0; b < spec.bodies.size(); ++b) {
     first_id.push_back(static_cast<int64_t>(total));
-    seeded.push_back(SeedBody(spec, b));
+    seeded.push_back(SeedBody(spec, b, model.obstacles));
     total += static_cast<double>(seeded.back().x.size());
     if (total > kMaxParticles) {
       Fail(spec.bodies[b].loc, BodyPath(b),

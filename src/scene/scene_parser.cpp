@@ -11,6 +11,8 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <type_traits>
+#include <variant>
 #include <set>
 
 #include "scene/scene_error.h"
@@ -412,6 +414,8 @@ class Parser {
   void ParseElasticPair(const YAML::Node& n, const std::string& path, MaterialSpec& m) const;
   RegionShape ParseRegion(const YAML::Node& n, const std::string& path) const;
   BodySpec ParseBody(const YAML::Node& n, const std::string& path, const SceneSpec& spec) const;
+  ObstacleSpec ParseObstacle(const YAML::Node& n, const std::string& path) const;
+  ObstacleShapeSpec ParseObstacleShape(const YAML::Node& n, const std::string& path) const;
 
   std::string source_;
   std::string base_dir_;
@@ -776,11 +780,111 @@ BodySpec Parser::ParseBody(const YAML::Node& n, const std::string& path,
   return b;
 }
 
+ObstacleShapeSpec Parser::ParseObstacleShape(const YAML::Node& n, const std::string& path) const {
+  const std::vector<std::string> kinds = {"plane", "box", "sphere", "cylinder", "polygon", "mesh"};
+  ExpectMap(n, path, kinds);
+  if (n.size() != 1) {
+    Fail(n, path, "expected exactly one of: " + Join(kinds) + ", got " + std::to_string(n.size()));
+  }
+  const std::string kind = n.begin()->first.Scalar();
+  const YAML::Node s = n.begin()->second;
+  const std::string p = Child(path, kind);
+  if (kind == "plane") {
+    ExpectMap(s, p, {"point", "normal"});
+    PlaneShape plane;
+    plane.point = Vector(Need(s, p, "point"), Child(p, "point"), "m");
+    const Vec3 normal = Vector(Need(s, p, "normal"), Child(p, "normal"), "-");
+    if (!(normal.norm() > 0)) Fail(s["normal"], Child(p, "normal"), "must not be the zero vector");
+    plane.normal = normal.normalized();
+    return plane;
+  }
+  if (kind == "mesh") {
+    if (dim_ == 2) Fail(n.begin()->first, p, "mesh obstacles are 3-D only (in 2-D use polygon)");
+    ExpectMap(s, p, {"file", "scale", "rotate_deg", "translate", "one_sided"});
+    ObstacleMeshSpec mesh;
+    const YAML::Node file = Need(s, p, "file");
+    const std::filesystem::path f = String(file, Child(p, "file"));
+    mesh.file = std::filesystem::absolute(f.is_absolute() ? f : std::filesystem::path(base_dir_) / f)
+                    .lexically_normal()
+                    .string();
+    mesh.file_loc = Loc(file, Child(p, "file"));
+    if (s["scale"]) mesh.scale = Positive(s["scale"], Child(p, "scale"), "-");
+    if (s["rotate_deg"]) mesh.rotate_deg = Vector(s["rotate_deg"], Child(p, "rotate_deg"), "deg");
+    if (s["translate"]) mesh.translate = Vector(s["translate"], Child(p, "translate"), "m");
+    if (s["one_sided"]) mesh.one_sided = Bool(s["one_sided"], Child(p, "one_sided"));
+    return mesh;
+  }
+  // box, sphere, cylinder, polygon: the region shapes.
+  const RegionShape region = ParseRegion(n, path);
+  return std::visit([](const auto& r) -> ObstacleShapeSpec {
+    if constexpr (std::is_same_v<std::decay_t<decltype(r)>, MeshRegion>) {
+      return ObstacleMeshSpec{};  // not reached: mesh is handled above
+    } else {
+      return r;
+    }
+  }, region);
+}
+
+ObstacleSpec Parser::ParseObstacle(const YAML::Node& n, const std::string& path) const {
+  ObstacleSpec o;
+  o.loc = Loc(n, path);
+  ExpectMap(n, path, {"name", "shape", "motion", "contact", "reference_point"});
+  o.name = Identifier(Need(n, path, "name"), Child(path, "name"));
+  if (o.name == "domain") {
+    Fail(n["name"], Child(path, "name"),
+         "'domain' is reserved for the domain walls in the force log; choose another name");
+  }
+  const YAML::Node shape = Need(n, path, "shape");
+  o.shape_loc = Loc(shape, Child(path, "shape"));
+  o.shape = ParseObstacleShape(shape, Child(path, "shape"));
+  if (n["motion"]) {
+    const YAML::Node m = n["motion"];
+    const std::string mp = Child(path, "motion");
+    if (m.IsScalar()) {
+      if (m.Scalar() == "prescribed") {
+        Fail(m, mp, "a prescribed motion needs its velocities: write {prescribed: {velocity: [..]}}");
+      }
+      if (m.Scalar() != "fixed") {
+        Fail(m, mp, "unknown motion '" + m.Scalar() + "' (expected fixed or {prescribed: {...}})");
+      }
+    } else {
+      ExpectMap(m, mp, {"fixed", "prescribed"});
+      if (m["fixed"]) Fail(m, mp, "write motion: fixed (a plain value)");
+      const YAML::Node pr = Need(m, mp, "prescribed");
+      const std::string pp = Child(mp, "prescribed");
+      ExpectMap(pr, pp, {"velocity", "angular_velocity_deg", "center"});
+      o.motion = ObstacleMotionKind::kPrescribed;
+      if (pr["velocity"]) o.velocity = Vector(pr["velocity"], Child(pp, "velocity"), "m/s");
+      if (pr["angular_velocity_deg"]) {
+        const YAML::Node w = pr["angular_velocity_deg"];
+        const std::string wp = Child(pp, "angular_velocity_deg");
+        if (dim_ == 2) {  // rotation about z only: one number
+          o.angular_velocity_deg = Vec3(0, 0, Number(w, wp, "deg/s (about z in 2-D)"));
+        } else {
+          o.angular_velocity_deg = Vector(w, wp, "deg/s");
+        }
+      }
+      if (pr["center"]) o.center = Vector(pr["center"], Child(pp, "center"), "m");
+    }
+  }
+  if (n["contact"]) {
+    const YAML::Node c = n["contact"];
+    const std::string cp = Child(path, "contact");
+    ExpectMap(c, cp, {"friction", "separable"});
+    if (c["friction"]) o.contact.friction = NonNegative(c["friction"], Child(cp, "friction"), "-");
+    if (c["separable"]) o.contact.separable = Bool(c["separable"], Child(cp, "separable"));
+  }
+  if (n["reference_point"]) {
+    o.reference_point = Vector(n["reference_point"], Child(path, "reference_point"), "m");
+  }
+  return o;
+}
+
 SceneSpec Parser::Parse(const YAML::Node& root) {
   SceneSpec spec;
   const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
-                                        "grid",   "domain",    "materials", "bodies",  "output",
-                                        "parameters"};
+                                        "grid",   "domain",    "materials", "bodies",  "obstacles",
+                                        "output", "parameters"};
   if (!root.IsDefined() || root.IsNull()) {
     throw SceneError(source_, 0, 0, "", "the scene is empty (expected a map with keys " + Join(top) + ")");
   }
@@ -881,6 +985,21 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
         }
       }
       spec.bodies.push_back(std::move(b));
+    }
+  }
+
+  if (root["obstacles"]) {
+    const YAML::Node os = root["obstacles"];
+    if (!os.IsSequence()) Fail(os, "obstacles", "expected a list of obstacles, got " + Describe(os));
+    for (size_t i = 0; i < os.size(); ++i) {
+      ObstacleSpec o = ParseObstacle(os[i], Index("obstacles", i));
+      for (size_t j = 0; j < spec.obstacles.size(); ++j) {
+        if (spec.obstacles[j].name == o.name) {
+          Fail(os[i]["name"], Child(Index("obstacles", i), "name"),
+               "duplicate obstacle name '" + o.name + "' (also obstacles[" + std::to_string(j) + "])");
+        }
+      }
+      spec.obstacles.push_back(std::move(o));
     }
   }
 
@@ -1000,6 +1119,64 @@ AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
   return a;
 }
 
+void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
+  e << YAML::BeginMap;
+  e << YAML::Key << "name" << YAML::Value << o.name;
+  e << YAML::Key << "shape" << YAML::Value;
+  if (const auto* plane = std::get_if<PlaneShape>(&o.shape)) {
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "plane" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "point" << YAML::Value;
+    EmitVector(e, plane->point, dim);
+    e << YAML::Key << "normal" << YAML::Value;
+    EmitVector(e, plane->normal, dim);
+    e << YAML::EndMap << YAML::EndMap;
+  } else if (const auto* mesh = std::get_if<ObstacleMeshSpec>(&o.shape)) {
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "mesh" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "file" << YAML::Value << mesh->file;
+    e << YAML::Key << "scale" << YAML::Value << Num(mesh->scale);
+    e << YAML::Key << "rotate_deg" << YAML::Value;
+    EmitVector(e, mesh->rotate_deg, dim);
+    e << YAML::Key << "translate" << YAML::Value;
+    EmitVector(e, mesh->translate, dim);
+    e << YAML::Key << "one_sided" << YAML::Value << mesh->one_sided;
+    e << YAML::EndMap << YAML::EndMap;
+  } else {
+    std::visit([&](const auto& r) {
+      if constexpr (!std::is_same_v<std::decay_t<decltype(r)>, PlaneShape> &&
+                    !std::is_same_v<std::decay_t<decltype(r)>, ObstacleMeshSpec>) {
+        EmitRegion(e, RegionShape(r), dim);
+      }
+    }, o.shape);
+  }
+  e << YAML::Key << "motion" << YAML::Value;
+  if (o.motion == ObstacleMotionKind::kFixed) {
+    e << "fixed";
+  } else {
+    e << YAML::BeginMap << YAML::Key << "prescribed" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "velocity" << YAML::Value;
+    EmitVector(e, o.velocity, dim);
+    e << YAML::Key << "angular_velocity_deg" << YAML::Value;
+    if (dim == 2) {
+      e << Num(o.angular_velocity_deg.z());
+    } else {
+      EmitVector(e, o.angular_velocity_deg, dim);
+    }
+    if (o.center) {
+      e << YAML::Key << "center" << YAML::Value;
+      EmitVector(e, *o.center, dim);
+    }
+    e << YAML::EndMap << YAML::EndMap;
+  }
+  e << YAML::Key << "contact" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+    << "friction" << YAML::Value << Num(o.contact.friction) << YAML::Key << "separable"
+    << YAML::Value << o.contact.separable << YAML::EndMap;
+  if (o.reference_point) {
+    e << YAML::Key << "reference_point" << YAML::Value;
+    EmitVector(e, *o.reference_point, dim);
+  }
+  e << YAML::EndMap;
+}
+
 std::string SceneSpecToYaml(const SceneSpec& spec) {
   const int dim = spec.dimension;
   YAML::Emitter e;
@@ -1106,6 +1283,12 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     e << YAML::EndMap;
   }
   e << YAML::EndSeq;
+
+  if (!spec.obstacles.empty()) {
+    e << YAML::Key << "obstacles" << YAML::Value << YAML::BeginSeq;
+    for (const ObstacleSpec& o : spec.obstacles) EmitObstacle(e, o, dim);
+    e << YAML::EndSeq;
+  }
 
   e << YAML::Key << "output" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "every" << YAML::Value << Num(spec.output.every);

@@ -178,6 +178,32 @@ struct BodySpec {
   SourceLoc region_loc;  // the `region` map
 };
 
+// Obstacles (issue #5; docs/scene-reference.md `obstacles`). Box, sphere, cylinder and polygon
+// reuse the region shapes; a plane and a mesh have their own.
+struct ObstacleMeshSpec {
+  std::string file;                 // resolved path (as MeshRegion)
+  Real scale = 1;                   // [-]
+  Vec3 rotate_deg = Vec3::Zero();   // rotations about x, then y, then z [deg]
+  Vec3 translate = Vec3::Zero();    // [m], applied last
+  bool one_sided = false;           // an open mesh: its triangle normals point to the outside
+  SourceLoc file_loc;
+};
+using ObstacleShapeSpec =
+    std::variant<PlaneShape, BoxRegion, SphereRegion, CylinderRegion, PolygonRegion, ObstacleMeshSpec>;
+
+struct ObstacleSpec {
+  std::string name;
+  ObstacleShapeSpec shape;
+  ObstacleMotionKind motion = ObstacleMotionKind::kFixed;
+  Vec3 velocity = Vec3::Zero();              // prescribed [m/s]
+  Vec3 angular_velocity_deg = Vec3::Zero();  // prescribed [deg/s]
+  std::optional<Vec3> center;                // centre of rotation; default: reference point
+  ObstacleContact contact;
+  std::optional<Vec3> reference_point;       // torque reference; default: centre of the bounds
+  SourceLoc loc;
+  SourceLoc shape_loc;
+};
+
 struct OutputSpec {
   Real every = 0;  // [s]; 0 = first and last only
   bool vdb = false;
@@ -194,6 +220,7 @@ struct SceneSpec {
   DomainSpec domain;
   std::vector<MaterialSpec> materials;  // in file order; Model::materials has the same order
   std::vector<BodySpec> bodies;
+  std::vector<ObstacleSpec> obstacles;  // in file order; Model::obstacles has the same order
   OutputSpec output;
   // `parameters:` in file order, after --set overrides; `${expr}` values were evaluated over
   // them before validation (scene_expressions.h).

@@ -27,6 +27,16 @@ void GridUpdateStage(const Model& m, const StepContext& c, State& s, Workspace& 
   s.wall_work += r.walls.work;
 }
 
+void ObstacleContactStage(const Model& m, const StepContext& c, State&, Workspace& w,
+                          StepReport& r) {
+  ApplyObstacleContact(m, c, w.grid, w.contact, &r.obstacles);
+}
+
+void ObstacleProjectionStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                             StepReport& r) {
+  ProjectParticlesOutOfObstacles(m, c, s.particles, w.contact, &r.obstacles);
+}
+
 void GridToParticleUslStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                             StepReport&) {
   GridToParticle(m, c, w.grid, s.particles, &w.velocity_gradient, nullptr);
@@ -40,6 +50,9 @@ void GridToParticleMuslStage(const Model& m, const StepContext& c, State& s, Wor
 void RemapMomentumStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                         StepReport&) {
   RemapMomentum(m, c, s.particles, w.grid);
+  // The re-mapped velocities obey the obstacles too (no reaction logged: the step's impulse
+  // was counted in ObstacleContact).
+  if (!m.obstacles.empty()) ApplyObstacleContact(m, c, w.grid, w.contact, nullptr);
 }
 
 void VelocityGradientStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -63,6 +76,65 @@ void AntiLockingStage(const Model& m, const StepContext& c, State& s, Workspace&
 void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                        StepReport&) {
   UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles);
+}
+
+namespace {
+// Walled faces of the domain, in face order.
+std::vector<int> WalledFaces(const Model& m) {
+  std::vector<int> faces;
+  for (int f = 0; f < 2 * m.dim; ++f)
+    if (m.walls[f].kind != WallKind::kOpen) faces.push_back(f);
+  return faces;
+}
+}  // namespace
+
+std::vector<ForceChannel> ForceChannels(const Model& m) {
+  std::vector<ForceChannel> channels;
+  const std::vector<int> walled = WalledFaces(m);
+  if (!walled.empty()) {
+    ForceChannel domain{"domain", {}};
+    for (int f : walled) domain.faces.push_back(FaceName(Face(f)));
+    channels.push_back(std::move(domain));
+  }
+  for (const Obstacle& o : m.obstacles) channels.push_back({o.name, o.faces});
+  return channels;
+}
+
+void CollectForces(const Model& m, const StepReport& step, ContactReport& out) {
+  const std::vector<int> walled = WalledFaces(m);
+  out.structures.resize((walled.empty() ? 0 : 1) + m.obstacles.size());
+  size_t k = 0;
+  if (!walled.empty()) {
+    ObstacleForce& d = out.structures[k++];
+    d = ObstacleForce{};
+    const Real cell_area = m.dim == 3 ? m.dx * m.dx : m.dx;  // h^(d-1), Mast 2013 (7.15)
+    for (int f : walled) {
+      FaceForce face;
+      face.force = step.walls.force[f];
+      face.contact_nodes = step.walls.contact_nodes[f];
+      face.contact_area = Real(face.contact_nodes) * cell_area;
+      d.force += face.force;
+      d.torque += step.walls.torque[f];
+      d.contact_nodes += face.contact_nodes;
+      d.faces.push_back(face);
+    }
+    d.contact_area = Real(d.contact_nodes) * cell_area;
+    d.max_nodal_force = step.walls.max_nodal_force;
+    if (d.contact_nodes > 0) {  // above the domain's lowest corner
+      const Vec3 up = UpDirection(m);
+      Real base = std::numeric_limits<Real>::infinity();
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 corner((c & 1) ? m.domain_max.x() : m.domain_min.x(),
+                          (c & 2) ? m.domain_max.y() : m.domain_min.y(),
+                          m.dim == 3 ? ((c & 4) ? m.domain_max.z() : m.domain_min.z()) : 0.0);
+        base = std::min(base, up.dot(corner));
+      }
+      d.wetted_height = step.walls.max_elevation - base;
+    }
+  }
+  for (size_t o = 0; o < m.obstacles.size(); ++o) {
+    out.structures[k++] = o < step.obstacles.size() ? step.obstacles[o] : ObstacleForce{};
+  }
 }
 
 // Particles beyond an open side leave the run (removed and counted, or the run stops, as

@@ -12,6 +12,10 @@ void RebuildGridStage(const Model&, const StepContext&, State&, Workspace&, Step
 void ReorderParticlesStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void ParticleToGridStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridUpdateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// Node contact with the rigid obstacles on v_{n+1} (src/contact), reactions into the report.
+void ObstacleContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// Particles that ended inside an obstacle go back to its surface (src/contact).
+void ObstacleProjectionStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridToParticleUslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridToParticleMuslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void RemapMomentumStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
@@ -25,6 +29,12 @@ void UpdateStressStage(const Model&, const StepContext&, State&, Workspace&, Ste
 void DomainExitStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void CheckStateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void EnergyStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+
+// What the force log records (DESIGN §7): "domain" (the walled faces) when a wall is not open,
+// then every obstacle with its faces.
+std::vector<ForceChannel> ForceChannels(const Model& model);
+// The step's reactions in ForceChannels order.
+void CollectForces(const Model& model, const StepReport& step, ContactReport& out);
 
 // End-of-step energies of a state (also used by tests and the run summary).
 EnergyRecord ComputeEnergy(const Model& model, const State& state);

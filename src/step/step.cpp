@@ -6,6 +6,8 @@
 //         -> VelocityGradient -> UpdateStress
 //   then: DomainExit -> CheckState -> Energy
 //   AntiLocking (Mast 2013 Table 4.1) runs just before UpdateStress when a material asks for it.
+//   With obstacles: ObstacleContact after GridUpdate (node contact, reactions) and
+//   ObstacleProjection after the positions are committed (particles back onto the surface).
 #include "step/step.h"
 
 #include <algorithm>
@@ -26,6 +28,8 @@ Pipeline MakePipeline(const Model& model) {
   p.push_back({Stage::kReorderParticles, ReorderParticlesStage});
   p.push_back({Stage::kParticleToGrid, ParticleToGridStage});                  // (2.12)
   p.push_back({Stage::kGridUpdate, GridUpdateStage});                          // (2.13)-(2.14)
+  const bool obstacles = !model.obstacles.empty();
+  if (obstacles) p.push_back({Stage::kObstacleContact, ObstacleContactStage});  // spec §5.3
   const bool antilocking = AnyAntiLocking(model);
   if (model.scheme == UpdateScheme::kUsl) {
     p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)
@@ -35,6 +39,7 @@ Pipeline MakePipeline(const Model& model) {
     p.push_back({Stage::kRemapMomentum, RemapMomentumStage});                  // Sulsky 1995
     p.push_back({Stage::kVelocityGradient, VelocityGradientStage});            // (2.17)
   }
+  if (obstacles) p.push_back({Stage::kObstacleProjection, ObstacleProjectionStage});
   if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
   p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)
   p.push_back({Stage::kDomainExit, DomainExitStage});

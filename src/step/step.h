@@ -4,6 +4,7 @@
 #include <array>
 #include <vector>
 
+#include "contact/contact_report.h"
 #include "core/model.h"
 #include "core/stage.h"
 #include "core/state.h"
@@ -18,6 +19,7 @@ struct StepReport {
   EnergyRecord energy;           // end-of-step energies (when the energy stage is in the pipeline)
   Health health;                 // first problem found by CheckState / DomainExit / time step
   WallReport walls;              // wall reactions of the last step
+  std::vector<ObstacleForce> obstacles;  // obstacle reactions of the last step (Model order)
   int64_t removed_last_step = 0; // particles removed through open sides in the last step
 };
 

@@ -2,6 +2,7 @@
 #pragma once
 #include <vector>
 
+#include "contact/contact.h"
 #include "grid/sparse_grid.h"
 #include "stabilize/antilocking.h"
 #include "transfer/transfer.h"
@@ -15,6 +16,7 @@ struct Workspace {
   std::vector<uint8_t> exit_flag;       // scratch of DomainExit and ReorderParticles
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
   AntiLockingScratch antilocking;       // node sums of AntiLocking
+  ContactScratch contact;               // broad phase and partial sums of the obstacle contact
 };
 
 }  // namespace surge

@@ -2,7 +2,10 @@
 // Walls act on v_{n+1}; the FLIP increment dv = v_{n+1} - v_n then carries the constraint to
 // the particles (the [REC] variant of spec §1.3), and the reaction is the momentum removed:
 // R = -m_i (v_c - v_u) / dt, summed per face.
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <tuple>
 
 #include "core/parallel.h"
 #include "transfer/transfer.h"
@@ -67,17 +70,26 @@ inline bool ApplyWalls(const WallPlane* walls, int count, const Vec3& xn, Real t
 
 }  // namespace
 
+// Per-block partial sums of the walls: per face force (3), torque about the origin (3) and
+// nodes with mass (1), then the work, the largest nodal reaction and the highest node.
+constexpr int kFaceSums = 7;
+constexpr int kWork = kFaceSums * kFaceCount, kMaxNodal = kWork + 1, kMaxElevation = kWork + 2;
+static_assert(kMaxElevation + 1 == std::tuple_size_v<SparseGrid::WallPartial>);
+
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report) {
   WallPlane walls[kFaceCount];
   const int wall_count = ActiveWalls(model, walls);
   const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, robust to round-off of i*dx
+  const Real g = model.gravity.norm();
+  const Vec3 up = g > 0 ? Vec3(-model.gravity / g) : Vec3::UnitY();
   const size_t nb = grid.block_count();
   // Per-block partial reactions, summed in block order afterwards (deterministic).
-  std::vector<std::array<Real, 19>>& partial = grid.wall_partials;  // 6 faces x 3 + work
+  std::vector<SparseGrid::WallPartial>& partial = grid.wall_partials;
   partial.assign(nb, {});
   ParallelFor(nb, 4, [&](size_t b) {
     auto& part = partial[b];
+    part[kMaxElevation] = -std::numeric_limits<Real>::infinity();
     for (int l = 0; l < kBlockNodes; ++l) {
       const size_t i = b * kBlockNodes + l;
       const Real m = grid.mass[i];
@@ -92,24 +104,44 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
       Vec3 vc = vu;
       if (wall_count > 0) {
         const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
+        const Vec3 x = node.cast<Real>() * ctx.dx;
         Vec3 dv[kFaceCount];
-        if (ApplyWalls(walls, wall_count, node.cast<Real>() * ctx.dx, tolerance, vc, dv)) {
-          // Reaction on each wall: R = -m dv / dt (spec §5.3).
-          for (int k = 0; k < wall_count; ++k)
-            for (int d = 0; d < 3; ++d) part[3 * walls[k].face + d] -= m * dv[k][d] / ctx.dt;
+        if (ApplyWalls(walls, wall_count, x, tolerance, vc, dv)) {
+          // Reaction on each wall: R = -m dv / dt (spec §5.3), its moment, its node count.
+          for (int k = 0; k < wall_count; ++k) {
+            const Real depth = walls[k].sign * (x[walls[k].axis] - walls[k].level);
+            if (depth > tolerance) continue;  // this wall did not act on the node
+            Real* f = &part[kFaceSums * walls[k].face];
+            const Vec3 r = -m * dv[k] / ctx.dt;
+            const Vec3 tq = x.cross(r);
+            for (int d = 0; d < 3; ++d) {
+              f[d] += r[d];
+              f[3 + d] += tq[d];
+            }
+            f[6] += depth >= -tolerance ? 1 : 0;  // area: the nodes on the plane only
+          }
+          part[kMaxNodal] = std::max(part[kMaxNodal], m * (vc - vu).norm() / ctx.dt);
+          part[kMaxElevation] = std::max(part[kMaxElevation], up.dot(x));
           // Work of the wall force on the material at the constrained velocity: zero for
           // fixed and frictionless walls, negative for sliding friction.
-          part[18] += m * (vc - vu).dot(vc);
+          part[kWork] += m * (vc - vu).dot(vc);
         }
       }
       grid.velocity_new[i] = vc;
     }
   });
   report = WallReport{};
+  report.max_elevation = -std::numeric_limits<Real>::infinity();
   for (size_t b = 0; b < nb; ++b) {
-    for (int f = 0; f < kFaceCount; ++f)
-      report.force[f] += Vec3(partial[b][3 * f], partial[b][3 * f + 1], partial[b][3 * f + 2]);
-    report.work += partial[b][18];
+    for (int f = 0; f < kFaceCount; ++f) {
+      const Real* p = &partial[b][kFaceSums * f];
+      report.force[f] += Vec3(p[0], p[1], p[2]);
+      report.torque[f] += Vec3(p[3], p[4], p[5]);
+      report.contact_nodes[f] += int64_t(p[6]);
+    }
+    report.work += partial[b][kWork];
+    report.max_nodal_force = std::max(report.max_nodal_force, partial[b][kMaxNodal]);
+    report.max_elevation = std::max(report.max_elevation, partial[b][kMaxElevation]);
   }
 }
 

@@ -27,8 +27,12 @@ void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles&
 
 // Per-face wall results of one grid update.
 struct WallReport {
-  std::array<Vec3, 6> force{};  // reaction force on each wall (on the wall, from the material) [N]
-  Real work = 0;                // work of all walls on the material during this step [J]
+  std::array<Vec3, 6> force{};   // reaction force on each wall (on the wall, from the material) [N]
+  std::array<Vec3, 6> torque{};  // moment of that force about the origin [N m]
+  std::array<int64_t, 6> contact_nodes{};  // wall nodes with mass (seed BArea, eq. (7.15))
+  Real max_nodal_force = 0;      // largest |nodal reaction| over all walls [N]
+  Real max_elevation = 0;        // highest wall node with mass along -g (UpDirection) [m]
+  Real work = 0;                 // work of all walls on the material during this step [J]
 };
 
 // Grid solve (2.13)-(2.14) and domain walls (seed Planar / Fixed nodes, spec §5.3): v_n = p/m,

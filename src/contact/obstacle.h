@@ -1,0 +1,76 @@
+// Rigid obstacles (DESIGN §6, issue #5): shape, motion and contact law of one structure, as the
+// scene builder hands it to the run. Geometry queries live in geometry.cpp (primitives, closed
+// form) and mesh_distance.cpp (triangle meshes, FCL); the node contact in contact.cpp.
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/math.h"
+
+namespace surge {
+
+class MeshDistanceField;  // mesh_distance.h
+
+// Shapes are given in world coordinates at t = 0 (the obstacle's reference pose).
+struct PlaneShape {  // half-space: the structure is the side opposite to `normal`
+  Vec3 point = Vec3::Zero();   // a point on the plane [m]
+  Vec3 normal = Vec3::UnitY(); // unit, from the structure into the material (seed App. B Fig. B.6)
+};
+struct BoxShape {  // axis-aligned in the reference pose; faces x-, x+, y-, y+, z-, z+
+  Vec3 min = Vec3::Zero();  // [m]
+  Vec3 max = Vec3::Zero();  // [m]
+};
+struct SphereShape {  // a disk (a cylinder along z) in 2-D; one face "surface"
+  Vec3 center = Vec3::Zero();  // [m]
+  Real radius = 0;             // [m]
+};
+struct CylinderShape {  // 3-D; faces "side", "base", "top"
+  Vec3 base = Vec3::Zero();  // centre of the base disk [m]
+  Vec3 top = Vec3::Zero();   // centre of the top disk [m]
+  Real radius = 0;           // [m]
+};
+struct PolygonShape {  // simple xy polygon extruded over [z0, z1] (infinite in z in 2-D);
+                       // faces "edge0".."edge<n-1>" (edge k runs from point k to k+1), "z-", "z+"
+  std::vector<std::array<Real, 2>> points;  // [m]
+  Real z0 = 0;  // [m] (3-D only)
+  Real z1 = 0;  // [m] (3-D only)
+};
+struct MeshShape {  // triangle mesh (3-D), after scale / rotation / translation
+  std::string file;
+  std::shared_ptr<const MeshDistanceField> field;  // BVH + pseudo-normals, built by the builder
+};
+using ObstacleShape =
+    std::variant<PlaneShape, BoxShape, SphereShape, CylinderShape, PolygonShape, MeshShape>;
+
+enum class ObstacleMotionKind { kFixed, kPrescribed };
+
+// Prescribed rigid motion: x(t) = c(t) + R(t) (x0 - c0), c(t) = c0 + v t, R(t) = exp(t [omega]x).
+struct ObstacleMotion {
+  ObstacleMotionKind kind = ObstacleMotionKind::kFixed;
+  Vec3 velocity = Vec3::Zero();          // v [m/s]
+  Vec3 angular_velocity = Vec3::Zero();  // omega [rad/s] (2-D: z component only)
+  Vec3 center = Vec3::Zero();            // c0: centre of rotation at t = 0 [m]
+};
+
+// Node contact law (Bardenhagen et al. 2000, eq. (11); Anura3D manual §6.2): no penetration,
+// Coulomb friction |dv_t| <= mu |dv_n|, released in tension when separable.
+struct ObstacleContact {
+  Real friction = 0;      // Coulomb coefficient mu [-]
+  bool separable = true;  // false: sticky (bilateral in the normal direction)
+};
+
+struct Obstacle {
+  std::string name;                  // [A-Za-z0-9_-]+, HDF5 group and CSV file name
+  ObstacleShape shape;
+  ObstacleMotion motion;
+  ObstacleContact contact;
+  Vec3 reference_point = Vec3::Zero();  // torque is taken about this point (moves with the body) [m]
+  std::vector<std::string> faces;       // face names, in the order of ObstacleForce::faces
+  Vec3 bounds_min = Vec3::Zero();       // world AABB at t = 0 [m] (planes: +-infinity)
+  Vec3 bounds_max = Vec3::Zero();
+};
+
+}  // namespace surge

@@ -1,0 +1,229 @@
+// Rigid obstacles against closed forms (issue #5, shared/VALIDATION.md): hydrostatic thrust of
+// water at rest on an obstacle box and on a domain wall (1/2 rho g h^2 per metre), a block on an
+// incline of a frictional floor given as a domain wall and as a plane obstacle (a = g (sin th -
+// mu cos th), sticking when tan th <= mu), and the impulse balance of an elastic disk bouncing
+// off an obstacle (the logged force integrates to the disk's momentum change). In every case no
+// particle may end inside an obstacle.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "contact/geometry.h"
+#include "support/run_scene.h"
+
+namespace surge {
+namespace {
+
+// Largest depth of a particle inside any obstacle at the current state (0 when none is inside).
+Real MaxPenetration(const LoadedScene& scene) {
+  Real depth = 0;
+  for (const Obstacle& o : scene.model.obstacles) {
+    const ObstaclePose pose = PoseAt(o, scene.state.time);
+    for (const Vec3& x : scene.state.particles.x) {
+      const Real d = QueryObstacle(o, pose, x, scene.model.dim, 0, scene.model.dx).distance;
+      depth = std::max(depth, -d);
+    }
+  }
+  return depth;
+}
+
+Real TotalMass(const Particles& P) {
+  Real m = 0;
+  for (Real mp : P.mass) m += mp;
+  return m;
+}
+
+// --- Hydrostatic thrust ------------------------------------------------------------------------
+// Water (reduced bulk modulus, node-based anti-locking: the fluid default) fills x in [0, 0.1]
+// between the slip wall x- of the domain and an obstacle box on x >= 0.1; gravity ramped over
+// 0.2 s (seed App. B.2.3). After settling, the time-averaged horizontal force on each side is
+// compared with 1/2 rho g h^2 (per metre), h = m / (rho W) the incompressible depth.
+constexpr const char* kTankScene = R"(name: tank_obstacle
+dimension: 2
+time: {end: 1.0, cfl: 0.3}
+gravity: [0, -9.81]
+gravity_ramp: 0.2
+grid: {cell_size: 0.004, shape_function: quadratic_bspline, transfer: apic, update: usl}
+domain:
+  min: [0, 0]
+  max: [0.16, 0.12]
+  walls: {x-: slip, x+: slip, y-: slip, y+: slip}
+materials:
+  water: {model: newtonian_fluid, density: 997.5, bulk_modulus: 2.0e6, viscosity: 0.001}
+bodies:
+  - name: water
+    material: water
+    region: {box: {min: [0, 0], max: [0.1, 0.06]}}
+    particles_per_cell: 2
+obstacles:
+  - name: wall
+    shape: {box: {min: [0.1, 0], max: [0.16, 0.12]}}
+)";
+
+TEST(ObstacleTest, HydrostaticThrustOnObstacleBoxAndDomainWall) {
+  constexpr Real kRho = 997.5, kG = 9.81, kW = 0.1, kAvgFrom = 0.7;
+  LoadedScene scene = LoadSceneFromString(kTankScene, "tank_obstacle.yaml");
+  const Real mass = TotalMass(scene.state.particles);
+  const Real h = mass / (kRho * kW);
+  Real box = 0, wall = 0, floor_obstacle = 0;
+  int n = 0;
+  testing::RunUntil(scene, 1.0, [&](const State& s, const StepReport& r) {
+    if (s.time < kAvgFrom) return;
+    box += r.obstacles.at(0).force.x();                  // pushed towards +x
+    wall += -r.walls.force[int(Face::kXMin)].x();         // domain wall x-: pushed towards -x
+    floor_obstacle += r.obstacles.at(0).force.y();
+    ++n;
+  });
+  box /= n;
+  wall /= n;
+  floor_obstacle /= n;
+  const Real expected = 0.5 * kRho * kG * h * h;  // per metre of thickness
+  std::printf("hydrostatic thrust (h = %.4f m): obstacle box %.3f N/m, domain wall %.3f N/m, "
+              "1/2 rho g h^2 = %.3f N/m (errors %+.2f %%, %+.2f %%); vertical force on the box "
+              "%.3g N/m; deepest particle inside %.2e m\n",
+              h, box, wall, expected, 100 * (box / expected - 1), 100 * (wall / expected - 1),
+              floor_obstacle, MaxPenetration(scene));
+  EXPECT_NEAR(box, expected, 0.02 * expected);
+  EXPECT_NEAR(wall, expected, 0.02 * expected);
+  EXPECT_LT(std::abs(floor_obstacle), 0.02 * expected);  // a smooth vertical face: no shear
+  EXPECT_EQ(MaxPenetration(scene), 0);
+}
+
+// --- Block on an incline -----------------------------------------------------------------------
+// Gravity rotated by th (seed eq. (7.20) does the same for slopes); the floor y = 0 is either the
+// frictional domain wall y- or a plane obstacle with the same mu. The block's mean velocity along
+// the slope is fitted by least squares over t in [0.1, 0.4] s, after gravity was ramped up over
+// 0.05 s (seed App. B.2.3) and the contact has settled.
+std::string InclineScene(Real theta_deg, Real mu, bool obstacle) {
+  const Real th = theta_deg * std::numbers::pi / 180, g = 9.81;
+  const std::string floor =
+      obstacle ? "  walls: {x-: slip, x+: slip}\n"
+                 "obstacles:\n"
+                 "  - name: floor\n"
+                 "    shape: {plane: {point: [0, 0], normal: [0, 1]}}\n"
+                 "    contact: {friction: " + std::to_string(mu) + "}\n"
+               : "  walls: {x-: slip, x+: slip, y-: {friction: " + std::to_string(mu) + "}}\n";
+  // The obstacle lives below y = 0, inside the domain; the domain wall is the domain's edge.
+  const std::string ymin = obstacle ? "-0.2" : "0";
+  std::string text = "name: incline\ndimension: 2\ntime: {end: 0.4, cfl: 0.4}\ngravity_ramp: 0.05\n";
+  text += "gravity: [" + std::to_string(g * std::sin(th)) + ", " + std::to_string(-g * std::cos(th)) + "]\n";
+  text += "grid: {cell_size: 0.05, shape_function: quadratic_bspline, transfer: apic, update: musl}\n";
+  text += "domain:\n  min: [0, " + ymin + "]\n  max: [4, 1]\n" + floor.substr(0, floor.find("obstacles:"));
+  text += "materials:\n  rubber: {model: neo_hookean, density: 2000, youngs_modulus: 5.0e7, poisson_ratio: 0.3}\n";
+  text += "bodies:\n  - name: block\n    material: rubber\n"
+          "    region: {box: {min: [0.5, 0], max: [1.0, 0.25]}}\n    particles_per_cell: 2\n";
+  if (obstacle) text += floor.substr(floor.find("obstacles:"));
+  return text;
+}
+
+// Least-squares slope of the block's mean velocity along x over t in [t0, t1].
+Real FittedAcceleration(const std::string& scene_text, Real* penetration) {
+  LoadedScene scene = LoadSceneFromString(scene_text, "incline.yaml");
+  std::vector<Real> t, v;
+  testing::RunUntil(scene, 0.4, [&](const State& s, const StepReport&) {
+    if (s.time < 0.1) return;
+    Real m = 0, p = 0;
+    for (size_t i = 0; i < s.particles.size(); ++i) {
+      m += s.particles.mass[i];
+      p += s.particles.mass[i] * s.particles.v[i].x();
+    }
+    t.push_back(s.time);
+    v.push_back(p / m);
+  });
+  Real st = 0, sv = 0, stt = 0, stv = 0;
+  const Real n = Real(t.size());
+  for (size_t i = 0; i < t.size(); ++i) {
+    st += t[i];
+    sv += v[i];
+    stt += t[i] * t[i];
+    stv += t[i] * v[i];
+  }
+  *penetration = MaxPenetration(scene);
+  return (n * stv - st * sv) / (n * stt - st * st);
+}
+
+TEST(ObstacleTest, BlockSlidesDownAFrictionalInclineAtTheCoulombRate) {
+  constexpr Real kTheta = 30, kMu = 0.3, kG = 9.81;
+  const Real th = kTheta * std::numbers::pi / 180;
+  const Real expected = kG * (std::sin(th) - kMu * std::cos(th));
+  for (bool obstacle : {false, true}) {
+    Real penetration = 0;
+    const Real a = FittedAcceleration(InclineScene(kTheta, kMu, obstacle), &penetration);
+    std::printf("incline %g deg, mu %g, floor as %s: a = %.5f m/s^2, g (sin - mu cos) = %.5f "
+                "(error %+.3f %%); deepest particle inside %.2e m\n",
+                kTheta, kMu, obstacle ? "plane obstacle" : "domain wall", a, expected,
+                100 * (a / expected - 1), penetration);
+    EXPECT_NEAR(a, expected, 0.01 * expected);
+    EXPECT_EQ(penetration, 0);
+  }
+}
+
+TEST(ObstacleTest, BlockSticksWhenTanThetaIsBelowMu) {
+  constexpr Real kTheta = 15, kMu = 0.3;  // tan 15 deg = 0.268 < 0.3
+  for (bool obstacle : {false, true}) {
+    Real penetration = 0;
+    const Real a = FittedAcceleration(InclineScene(kTheta, kMu, obstacle), &penetration);
+    std::printf("incline %g deg, mu %g, floor as %s: a = %.3e m/s^2 (sticks: 0)\n", kTheta, kMu,
+                obstacle ? "plane obstacle" : "domain wall", a);
+    EXPECT_LT(std::abs(a), 0.01 * 9.81 * std::sin(kTheta * std::numbers::pi / 180));
+  }
+}
+
+// --- Impulse balance ---------------------------------------------------------------------------
+// An elastic disk (no gravity) hits an obstacle box and bounces off. The logged force on the
+// obstacle, summed as F dt over every step, equals the disk's momentum loss p(0) - p(end).
+constexpr const char* kDiskScene = R"(name: disk_impact
+dimension: 2
+time: {end: 0.12, cfl: 0.3}
+gravity: [0, 0]
+grid: {cell_size: 0.01, shape_function: quadratic_bspline, transfer: apic, update: musl}
+domain:
+  min: [0, 0]
+  max: [0.6, 0.6]
+materials:
+  rubber: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e6, poisson_ratio: 0.3}
+bodies:
+  - name: disk
+    material: rubber
+    region: {sphere: {center: [0.3, 0.3], radius: 0.08}}
+    particles_per_cell: 2
+    velocity: [-1.0, -2.0]
+obstacles:
+  - name: block
+    shape: {box: {min: [0.1, 0.05], max: [0.5, 0.2]}}
+)";
+
+TEST(ObstacleTest, LoggedImpulseEqualsTheMomentumTheDiskLoses) {
+  LoadedScene scene = LoadSceneFromString(kDiskScene, "disk_impact.yaml");
+  auto momentum = [](const Particles& P) {
+    Vec3 p = Vec3::Zero();
+    for (size_t i = 0; i < P.size(); ++i) p += P.mass[i] * P.v[i];
+    return p;
+  };
+  const Vec3 p0 = momentum(scene.state.particles);
+  Vec3 impulse = Vec3::Zero();
+  Real peak = 0, penetration = 0;
+  testing::RunUntil(scene, 0.12, [&](const State& s, const StepReport& r) {
+    impulse += s.dt * r.obstacles.at(0).force;
+    peak = std::max(peak, r.obstacles.at(0).force.norm());
+    penetration = std::max(penetration, MaxPenetration(scene));
+  });
+  const Vec3 dp = p0 - momentum(scene.state.particles);
+  std::printf("disk impact: momentum lost (%.5f, %.5f) N s, logged impulse (%.5f, %.5f) N s "
+              "(error %.3f %% of |p0|); peak force %.1f N/m; final vy %.3f m/s; deepest "
+              "particle inside %.2e m\n",
+              dp.x(), dp.y(), impulse.x(), impulse.y(), 100 * (impulse - dp).norm() / p0.norm(),
+              peak, momentum(scene.state.particles).y() / TotalMass(scene.state.particles),
+              penetration);
+  EXPECT_GT(-dp.y(), 0.5 * std::abs(p0.y()));      // it bounced: the y momentum reversed sign
+  EXPECT_LT((impulse - dp).norm(), 0.01 * dp.norm());
+  EXPECT_EQ(penetration, 0);
+  EXPECT_LT(std::abs(impulse.x()), 0.05 * std::abs(impulse.y()));  // smooth top face
+}
+
+}  // namespace
+}  // namespace surge
