@@ -6,11 +6,71 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 #include <variant>
 
 #include "scene/scene.h"
 
 namespace surge {
+
+namespace {
+
+// Obstacles the node contact cannot represent well (issue #5, docs/scene-reference.md
+// `obstacles`): thinner than two cells (nodes on both sides share one velocity, so material can
+// leak through), outside the domain (never touched), and box faces off the grid planes (the
+// seed's structures sit on grid planes, Mast 2013 §7.4; off-plane faces start the contact up to
+// one cell early).
+void ObstacleWarnings(const Model& m, std::vector<std::string>& out) {
+  for (size_t o = 0; o < m.obstacles.size(); ++o) {
+    const Obstacle& ob = m.obstacles[o];
+    Real thickness = std::numeric_limits<Real>::infinity();
+    std::visit(
+        [&](const auto& s) {
+          using S = std::decay_t<decltype(s)>;
+          if constexpr (std::is_same_v<S, BoxShape>) {
+            for (int a = 0; a < m.dim; ++a) thickness = std::min(thickness, s.max[a] - s.min[a]);
+          } else if constexpr (std::is_same_v<S, SphereShape>) {
+            thickness = 2 * s.radius;
+          } else if constexpr (std::is_same_v<S, CylinderShape>) {
+            thickness = std::min(2 * s.radius, (s.top - s.base).norm());
+          } else if constexpr (!std::is_same_v<S, PlaneShape>) {
+            for (int a = 0; a < m.dim; ++a)
+              thickness = std::min(thickness, ob.bounds_max[a] - ob.bounds_min[a]);
+          }
+        },
+        ob.shape);
+    if (thickness < 2 * m.dx)
+      out.push_back(fmt::format(
+          "obstacles[{}] '{}': {:.3g} m thick, less than two cells ({:.3g} m); grid nodes on both "
+          "sides share one velocity and material may pass through: make it thicker or refine "
+          "grid.cell_size",
+          o, ob.name, thickness, 2 * m.dx));
+    bool outside = false;
+    for (int a = 0; a < m.dim; ++a)
+      outside |= ob.bounds_max[a] < m.domain_min[a] || ob.bounds_min[a] > m.domain_max[a];
+    if (outside && ob.motion.kind == ObstacleMotionKind::kFixed)
+      out.push_back(fmt::format("obstacles[{}] '{}': lies outside the domain; nothing can touch it",
+                                o, ob.name));
+    if (const auto* box = std::get_if<BoxShape>(&ob.shape)) {
+      bool off = false;
+      for (int a = 0; a < m.dim; ++a) {
+        for (Real c : {box->min[a], box->max[a]}) {
+          const Real cells = c / m.dx;
+          off |= std::abs(cells - std::round(cells)) > 1e-6;
+        }
+      }
+      if (off && ob.motion.kind == ObstacleMotionKind::kFixed)
+        out.push_back(fmt::format(
+            "obstacles[{}] '{}': box faces do not lie on grid planes (multiples of cell_size "
+            "{:.6g} m); the contact then acts up to one cell before the face (Mast 2013 §7.4 "
+            "keeps structures on grid planes)",
+            o, ob.name, m.dx));
+    }
+  }
+}
+
+}  // namespace
 
 std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
   std::vector<std::string> out;
@@ -55,6 +115,7 @@ std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
           "weak compressibility needs Mach < 0.1: raise bulk_modulus to at least {:.3g} Pa",
           mat.name, v, m.bodies[b].name, mach, c, mat.density * 100.0 * v * v));
   }
+  ObstacleWarnings(m, out);
   return out;
 }
 

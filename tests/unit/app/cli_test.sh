@@ -48,6 +48,30 @@ expect check_mach_warn 0 'warning +materials\.water: .*Mach 0\.[0-9]+' -- "$surg
 expect check_mach_warn_bingham 0 'warning +materials\.mud: .*Mach' -- "$surge" check "$src/scenes/mudflow_2d.yaml" --set materials.mud.bulk_modulus=1.0e3
 expect info_lists_models 0 'materials: .*j2.*newtonian_fluid' -- "$surge" info
 expect check_linear_usl 0 'cell-crossing instability' -- "$surge" check "$src/scenes/two_disks_2d.yaml" --set grid.shape_function=linear --set grid.update=usl
+cat > "$work/obstacles.yaml" <<'YAML'
+name: obstacles
+dimension: 2
+time: {end: 0.02}
+gravity: [0, -9.81]
+grid: {cell_size: 0.02}
+domain: {min: [0, 0], max: [1, 1], walls: {y-: slip}}
+materials:
+  m: {model: neo_hookean, density: 1000, bulk_modulus: 1.0e6, shear_modulus: 1.0e5}
+bodies:
+  - {name: b, material: m, region: {box: {min: [0.2, 0.0], max: [0.4, 0.2]}}}
+obstacles:
+  - {name: fin, shape: {box: {min: [0.5, 0], max: [0.52, 0.5]}}}
+  - {name: post, shape: {box: {min: [0.605, 0], max: [0.7, 0.5]}}}
+YAML
+expect check_thin_obstacle 0 "obstacles\[0\] 'fin': 0.02 m thick, less than two cells" -- "$surge" check "$work/obstacles.yaml"
+expect check_off_grid_obstacle 0 "obstacles\[1\] 'post': box faces do not lie on grid planes" -- "$surge" check "$work/obstacles.yaml"
+expect run_obstacle_forces 0 'post +peak' -- "$surge" run "$work/obstacles.yaml" --out "$work/out_obstacles" --set time.end=0.05 --set "bodies.0.velocity=[4, 0]"
+if [ -s "$work/out_obstacles/forces_fin.csv" ] && [ -s "$work/out_obstacles/forces_domain.csv" ] && head -1 "$work/out_obstacles/forces_fin.csv" | grep -q '^time_s,step,dt_s,fx_N'; then
+  echo "ok   run_obstacle_csv"; pass=$((pass + 1))
+else
+  echo "FAIL run_obstacle_csv: forces_fin.csv / forces_domain.csv missing or without header"; fail=$((fail + 1))
+fi
+expect check_obstacle_named_domain 2 'obstacles\[0\]\.name.*reserved' -- "$surge" check "$work/obstacles.yaml" --set "obstacles.0.name=domain"
 expect bad_option 2 '' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --threads 0
 expect no_subcommand 2 '' -- "$surge"
 expect run_small 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out" --set time.end=0.2 --threads 2 --progress plain
