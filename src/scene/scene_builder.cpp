@@ -70,7 +70,7 @@ Obstacle BuildObstacle(const SceneSpec& spec, size_t index) {
       [&](const auto& s) {
         using S = std::decay_t<decltype(s)>;
         if constexpr (std::is_same_v<S, PlaneShape>) {
-          o.shape = s;
+          o.shape = PlaneShape{s.point, s.normal.normalized()};  // the spec keeps it as given
         } else if constexpr (std::is_same_v<S, BoxRegion>) {
           o.shape = BoxShape{s.min, s.max};
         } else if constexpr (std::is_same_v<S, SphereRegion>) {

@@ -795,7 +795,9 @@ ObstacleShapeSpec Parser::ParseObstacleShape(const YAML::Node& n, const std::str
     plane.point = Vector(Need(s, p, "point"), Child(p, "point"), "m");
     const Vec3 normal = Vector(Need(s, p, "normal"), Child(p, "normal"), "-");
     if (!(normal.norm() > 0)) Fail(s["normal"], Child(p, "normal"), "must not be the zero vector");
-    plane.normal = normal.normalized();
+    // Kept as given; the builder normalises it. Normalising here would not round-trip: the
+    // resolved YAML would hold the unit vector, and normalising that again can move it by an ulp.
+    plane.normal = normal;
     return plane;
   }
   if (kind == "mesh") {
