@@ -24,14 +24,17 @@ constexpr int kFaceSlots = 4;  // fx, fy, fz, nodes
 // `vo` on each active face in turn; dv[k] receives face k's change. Seed spec §5.3 [REC]:
 // remove the approaching normal component (all of it when bilateral), then Coulomb friction on
 // the tangential remainder, |dv_t| <= mu |dv_n| (Bardenhagen et al. 2000, eq. (11)).
-inline void Constrain(const SurfaceQuery& q, const ObstacleContact& law, const Vec3& vo, Vec3& v,
-                      Vec3* dv) {
+// `hold` [m/s]: the separating normal speed the adhesion can still stop (0 without adhesion).
+inline void Constrain(const SurfaceQuery& q, const ObstacleContact& law, const Vec3& vo, Real hold,
+                      Vec3& v, Vec3* dv) {
   for (int k = 0; k < q.count; ++k) {
     const Vec3& n = q.normal[k];
     Vec3 rel = v - vo;
     const Real vn = rel.dot(n);  // > 0: moving away from the surface
     dv[k].setZero();
-    if (vn >= 0 && law.separable) continue;  // released in tension
+    // Released in tension unless the adhesion holds: pulling the node back needs the force
+    // m vn / dt, available up to adhesion x h^(d-1) (hold = that force x dt / m).
+    if (law.separable && (vn > hold || (vn >= 0 && hold == 0))) continue;
     rel -= vn * n;
     if (law.friction > 0) {
       const Vec3 vt = rel - rel.dot(n) * n;
@@ -77,6 +80,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
   const Vec3 up = UpDirection(model);
   if (report) report->assign(model.obstacles.size(), ObstacleForce{});
   const size_t nb = grid.block_count();
+  scratch.near_block.assign(nb, 0);
   for (size_t o = 0; o < model.obstacles.size(); ++o) {
     const Obstacle& ob = model.obstacles[o];
     const ObstaclePose pose = PoseAt(ob, t1);
@@ -100,6 +104,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
       Real* part = &scratch.partial[c * stride];
       part[kMaxElev] = -kInf;
       part[kMinElev] = kInf;
+      bool near = false;
       for (int l = 0; l < kBlockNodes; ++l) {
         const size_t i = b * kBlockNodes + l;
         const Real m = grid.mass[i];
@@ -107,13 +112,16 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
         const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
         const Vec3 x = node.cast<Real>() * ctx.dx;
         const SurfaceQuery q = QueryObstacle(ob, pose, x, model.dim, tol, 2 * ctx.dx);
+        near |= q.distance < 2 * ctx.dx;
         if (q.distance > tol || q.count == 0) continue;
         Vec3 dv[kMaxContactFaces];
         Vec3& v = grid.velocity_new[i];
         const Vec3 before = v;
-        Constrain(q, ob.contact, pose.PointVelocity(x), v, dv);
+        const Real hold = ob.contact.adhesion * cell_area * ctx.dt / m;
+        Constrain(q, ob.contact, pose.PointVelocity(x), hold, v, dv);
         // Force on the structure: the momentum the contact removed, m (v_u - v_c) / dt.
         const Vec3 f = m * (before - v) / ctx.dt;
+        if (report) grid.reaction[i] += f;  // not again in the MUSL re-application
         const Vec3 tq = (x - ref).cross(f);
         for (int d = 0; d < 3; ++d) {
           part[kFx + d] += f[d];
@@ -133,6 +141,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
           if (surface_layer) fp[3] += 1;
         }
       }
+      if (near) scratch.near_block[b] = 1;  // one writer per block: no race
     });
     if (!report) continue;
     ObstacleForce& r = (*report)[o];
@@ -161,14 +170,81 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
   }
 }
 
+void SumSensors(const Model& model, const StepContext& ctx, const SparseGrid& grid,
+                ContactScratch& scratch, std::vector<ObstacleForce>& out) {
+  const Real tol = 1e-9 * ctx.dx;
+  const Real cell_area = model.dim == 3 ? ctx.dx * ctx.dx : ctx.dx;  // h^(d-1), (7.15)
+  const Vec3 up = UpDirection(model);
+  out.assign(model.sensors.size(), ObstacleForce{});
+  const size_t nb = grid.block_count();
+  for (size_t s = 0; s < model.sensors.size(); ++s) {
+    const Sensor& sensor = model.sensors[s];
+    scratch.blocks.clear();
+    for (size_t b = 0; b < nb; ++b) {
+      const Vec3 blo = grid.block_origin[b].cast<Real>() * ctx.dx;
+      const Vec3 bhi = blo + Vec3::Constant((kBlockDim - 1) * ctx.dx);
+      bool overlap = true;
+      for (int a = 0; a < model.dim; ++a)
+        overlap &= bhi[a] >= sensor.min[a] - tol && blo[a] <= sensor.max[a] + tol;
+      if (overlap) scratch.blocks.push_back(int32_t(b));
+    }
+    const size_t stride = kHeader;
+    scratch.partial.assign(scratch.blocks.size() * stride, 0);
+    const Vec3 center = 0.5 * (sensor.min + sensor.max);
+    ParallelFor(scratch.blocks.size(), 1, [&](size_t c) {
+      const size_t b = size_t(scratch.blocks[c]);
+      Real* part = &scratch.partial[c * stride];
+      part[kMaxElev] = -kInf;
+      for (int l = 0; l < kBlockNodes; ++l) {
+        const size_t i = b * kBlockNodes + l;
+        if (grid.mass[i] <= 0) continue;
+        const Vec3& f = grid.reaction[i];
+        if (f.isZero(0)) continue;
+        const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
+        const Vec3 x = node.cast<Real>() * ctx.dx;
+        bool inside = true;
+        for (int a = 0; a < model.dim; ++a)
+          inside &= x[a] >= sensor.min[a] - tol && x[a] <= sensor.max[a] + tol;
+        if (!inside) continue;
+        const Vec3 tq = (x - center).cross(f);
+        for (int d = 0; d < 3; ++d) {
+          part[kFx + d] += f[d];
+          part[kTx + d] += tq[d];
+        }
+        part[kNodes] += 1;
+        part[kMaxNodal] = std::max(part[kMaxNodal], f.norm());
+        part[kMaxElev] = std::max(part[kMaxElev], up.dot(x));
+      }
+    });
+    ObstacleForce& r = out[s];
+    Real max_elev = -kInf;
+    for (size_t c = 0; c < scratch.blocks.size(); ++c) {  // block order: deterministic
+      const Real* part = &scratch.partial[c * stride];
+      r.force += Vec3(part[kFx], part[kFy], part[kFz]);
+      r.torque += Vec3(part[kTx], part[kTy], part[kTz]);
+      r.contact_nodes += int64_t(part[kNodes]);
+      r.max_nodal_force = std::max(r.max_nodal_force, part[kMaxNodal]);
+      max_elev = std::max(max_elev, part[kMaxElev]);
+    }
+    r.contact_area = Real(r.contact_nodes) * cell_area;
+    if (r.contact_nodes > 0) {
+      Real base = kInf;  // lowest corner of the sensor box along up
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 corner((c & 1) ? sensor.max.x() : sensor.min.x(),
+                          (c & 2) ? sensor.max.y() : sensor.min.y(),
+                          model.dim == 3 ? ((c & 4) ? sensor.max.z() : sensor.min.z()) : 0.0);
+        base = std::min(base, up.dot(corner));
+      }
+      r.wetted_height = max_elev - base;
+    }
+  }
+}
+
 int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ctx,
-                                       Particles& P, ContactScratch& scratch,
-                                       std::vector<ObstacleForce>* report) {
+                                       SparseGrid& grid, Particles& P,
+                                       ContactScratch& scratch, std::vector<ObstacleForce>* report) {
   const Real t1 = ctx.time + ctx.dt;  // positions are x_{n+1}
   const size_t no = model.obstacles.size();
-  constexpr int kSums = 7;  // force, torque, moved count
-  std::vector<Real>& partial = scratch.particle_partial;
-  partial.assign(kReductionChunks * no * kSums, 0);
   std::vector<ObstaclePose>& poses = scratch.poses;
   std::vector<Vec3>&lo = scratch.lo, &hi = scratch.hi, &ref = scratch.ref;
   poses.resize(no);
@@ -180,42 +256,68 @@ int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ct
     PosedBounds(model.obstacles[o], poses[o], lo[o], hi[o]);
     ref[o] = poses[o].ToWorld(model.obstacles[o].reference_point);
   }
+  scratch.moved.resize(kReductionChunks);
+  for (auto& m : scratch.moved) m.clear();
   ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
     for (size_t p = b; p < e; ++p) {
+      // Broad phase: the particle's block or one its stencil reaches was near an obstacle.
+      const int32_t blk = grid.particle_block[p];
+      bool near = scratch.near_block[size_t(blk)] != 0;
+      for (int k = 1; k < 8 && !near; ++k) {
+        const int32_t nbk = grid.neighbor[size_t(blk)][k];
+        near = nbk >= 0 && scratch.near_block[size_t(nbk)] != 0;
+      }
+      if (!near) continue;
       for (size_t o = 0; o < no; ++o) {
         Vec3& x = P.x[p];
         bool in_box = true;
         for (int a = 0; a < model.dim; ++a) in_box &= x[a] >= lo[o][a] && x[a] <= hi[o][a];
         if (!in_box) continue;
         const Obstacle& ob = model.obstacles[o];
-        const SurfaceQuery q = QueryObstacle(ob, poses[o], x, model.dim, 0, 2 * ctx.dx);
+        const SurfaceQuery q = QueryObstacle(ob, poses[o], x, model.dim, 0, ctx.dx);
         if (!(q.distance < 0) || q.count == 0) continue;
-        x -= q.distance * q.normal[0];  // back onto the nearest face
+        // Back onto the nearest exposed face, a hair (1e-9 h) outside so that round-off on
+        // rotated or curved faces cannot leave it inside.
+        x -= (q.distance - 1e-9 * ctx.dx) * q.normal[0];
         SurfaceQuery one = q;
         one.count = 1;
         Vec3 dv[kMaxContactFaces];
         const Vec3 before = P.v[p];
-        Constrain(one, ob.contact, poses[o].PointVelocity(x), P.v[p], dv);
+        Constrain(one, ob.contact, poses[o].PointVelocity(x), 0, P.v[p], dv);
         const Vec3 f = P.mass[p] * (before - P.v[p]) / ctx.dt;
-        const Vec3 tq = (x - ref[o]).cross(f);
-        Real* s = &partial[(chunk * no + o) * kSums];
-        for (int d = 0; d < 3; ++d) {
-          s[d] += f[d];
-          s[3 + d] += tq[d];
-        }
-        s[6] += 1;
+        scratch.moved[chunk].push_back({p, uint32_t(o), q.face[0], f, (x - ref[o]).cross(f)});
       }
     }
   });
+  // Serially, in chunk (= particle) order, deterministic: the momentum taken from each moved
+  // particle joins its obstacle's force, torque and face sums, and the reaction of the grid node
+  // nearest to it (for the force sensors). That node lies in the particle's owner block or one
+  // of its upper neighbours (the particle moved less than a cell since it was binned).
   int64_t moved = 0;
-  for (size_t o = 0; o < no; ++o) {
-    for (size_t c = 0; c < kReductionChunks; ++c) {
-      const Real* s = &partial[(c * no + o) * kSums];
+  for (const auto& list : scratch.moved) {
+    for (const ProjectedParticle& m : list) {
+      ++moved;
       if (report) {
-        (*report)[o].force += Vec3(s[0], s[1], s[2]);
-        (*report)[o].torque += Vec3(s[3], s[4], s[5]);
+        ObstacleForce& r = (*report)[m.obstacle];
+        r.force += m.force;
+        r.torque += m.torque;
+        if (m.face >= 0 && size_t(m.face) < r.faces.size()) r.faces[size_t(m.face)].force += m.force;
       }
-      moved += int64_t(s[6]);
+      const Vec3i node = (P.x[m.particle] * ctx.inv_dx).array().round().cast<int>();
+      const int32_t owner = grid.particle_block[m.particle];
+      const Vec3i local = node - grid.block_origin[size_t(owner)];
+      int k = 0;
+      bool ok = true;
+      for (int d = 0; d < 3; ++d) {
+        ok &= local[d] >= 0 && local[d] < 2 * kBlockDim;
+        if (local[d] >= kBlockDim) k |= 1 << d;
+      }
+      if (!ok) continue;
+      const int32_t blk = grid.neighbor[size_t(owner)][k];
+      if (blk < 0) continue;
+      const Vec3i l = local - Vec3i((k & 1) ? kBlockDim : 0, (k & 2) ? kBlockDim : 0,
+                                    (k & 4) ? kBlockDim : 0);
+      grid.reaction[size_t(blk) * kBlockNodes + LocalNode(l.x(), l.y(), l.z())] += m.force;
     }
   }
   return moved;

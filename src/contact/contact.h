@@ -3,6 +3,7 @@
 // walls) on v_{n+1}; the FLIP increment then carries the constraint to the particles, and the
 // momentum removed at a node is the reaction impulse.
 #pragma once
+#include <utility>
 #include <vector>
 
 #include "contact/contact_report.h"
@@ -14,11 +15,22 @@
 
 namespace surge {
 
+// A particle the projection moved: its obstacle and face, and the force and torque (about the
+// reference point) its momentum change puts on the structure.
+struct ProjectedParticle {
+  size_t particle = 0;
+  uint32_t obstacle = 0;
+  int32_t face = -1;
+  Vec3 force = Vec3::Zero();   // [N]
+  Vec3 torque = Vec3::Zero();  // [N m]
+};
+
 // Reused between steps (no allocation per step after warm-up).
 struct ContactScratch {
   std::vector<int32_t> blocks;  // candidate blocks of one obstacle (broad phase)
   std::vector<Real> partial;    // per candidate block: sums (layout in contact.cpp)
-  std::vector<Real> particle_partial;  // per reduction chunk and obstacle (projection)
+  std::vector<uint8_t> near_block;     // per grid block: a node with mass within 2 h of an obstacle
+  std::vector<std::vector<ProjectedParticle>> moved;  // per reduction chunk (projection)
   std::vector<ObstaclePose> poses;     // per obstacle at t_{n+1}
   std::vector<Vec3> lo, hi, ref;       // posed bounds and reference points
 };
@@ -35,12 +47,23 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
 // After the position update: a particle found inside an obstacle (possible within half a cell
 // of the surface, where the stencil still reaches free nodes) is put back on the surface along
 // the nearest face normal and loses its approaching normal velocity relative to the obstacle.
-// The momentum removed, m_p dv / dt, is added to (*report)[o].force and torque so that the
+// The momentum removed, m_p dv / dt, is added to (*report)[o].force, torque and the face's force so that the
 // logged impulse stays equal to the momentum the obstacle took. Deterministic for any thread
-// count. Returns the number of particles moved.
+// count. The same force is added to grid.reaction at the node nearest to the particle (for the
+// force sensors). Only particles binned (grid.particle_block) in a block that ApplyObstacleContact marked
+// near an obstacle, or whose +x/+y/+z neighbours it marked, are tested: a particle that ends
+// inside lies within half a cell of the surface, so a node of its stencil lies within 2 h of it.
+// Returns the number of particles moved.
 int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ctx,
-                                       Particles& particles, ContactScratch& scratch,
-                                       std::vector<ObstacleForce>* report);
+                                       SparseGrid& grid, Particles& particles,
+                                       ContactScratch& scratch, std::vector<ObstacleForce>* report);
+
+// Force sensors: (*out)[s] receives the sum of grid.reaction over the nodes inside sensor s
+// (force on the structures there, the particle-projection share included when it has run), its
+// moment about the box centre, the nodes with a non-zero reaction (contact nodes, area h^(d-1)
+// each), the largest nodal force and the wetted height above the box bottom.
+void SumSensors(const Model& model, const StepContext& ctx, const SparseGrid& grid,
+                ContactScratch& scratch, std::vector<ObstacleForce>& out);
 
 // Unit vector opposite to gravity (+y when there is none): "up" for wetted heights.
 Vec3 UpDirection(const Model& model);

@@ -18,11 +18,17 @@ namespace {
 
 constexpr Real kInf = std::numeric_limits<Real>::infinity();
 
+inline bool Buried(uint64_t buried, int face) { return face < 64 && ((buried >> face) & 1u); }
+
 // Collects the faces whose distance q[k] is within tol of the largest: the point is inside (or
-// on) every constraint, and the nearest faces are the ones that act.
+// on) every constraint, and the nearest faces are the ones that act. Buried faces (on or beyond
+// the domain boundary, Obstacle::buried_faces) never act: the nearest exposed faces do.
 template <size_t N>
-void ActiveFaces(const std::array<Real, N>& q, const std::array<Vec3, N>& n,
-                 const std::array<int, N>& face, Real tol, SurfaceQuery& out) {
+void ActiveFaces(const std::array<Real, N>& q_all, const std::array<Vec3, N>& n,
+                 const std::array<int, N>& face, Real tol, uint64_t buried, SurfaceQuery& out) {
+  std::array<Real, N> q = q_all;
+  for (size_t k = 0; k < N; ++k)
+    if (Buried(buried, face[k])) q[k] = -kInf;
   Real qmax = -kInf;
   for (size_t k = 0; k < N; ++k) qmax = std::max(qmax, q[k]);
   out.count = 0;
@@ -58,7 +64,7 @@ SurfaceQuery QueryPlane(const PlaneShape& s, const Vec3& p, Real tol) {
   return out;
 }
 
-SurfaceQuery QueryBox(const BoxShape& s, const Vec3& p, int dim, Real tol) {
+SurfaceQuery QueryBox(const BoxShape& s, const Vec3& p, int dim, Real tol, uint64_t buried) {
   const Vec3 c = 0.5 * (s.min + s.max), h = 0.5 * (s.max - s.min);
   std::array<Real, 3> q;
   std::array<Vec3, 3> n;
@@ -72,7 +78,7 @@ SurfaceQuery QueryBox(const BoxShape& s, const Vec3& p, int dim, Real tol) {
   }
   SurfaceQuery out;
   out.distance = CombineBox(q);
-  if (out.distance <= tol) ActiveFaces(q, n, face, tol, out);
+  if (out.distance <= tol) ActiveFaces(q, n, face, tol, buried, out);
   return out;
 }
 
@@ -90,7 +96,7 @@ SurfaceQuery QuerySphere(const SphereShape& s, const Vec3& p, int dim, Real tol)
   return out;
 }
 
-SurfaceQuery QueryCylinder(const CylinderShape& s, const Vec3& p, Real tol) {
+SurfaceQuery QueryCylinder(const CylinderShape& s, const Vec3& p, Real tol, uint64_t buried) {
   const Vec3 axis_vec = s.top - s.base;
   const Real length = axis_vec.norm();
   const Vec3 a = axis_vec / length;
@@ -107,12 +113,13 @@ SurfaceQuery QueryCylinder(const CylinderShape& s, const Vec3& p, Real tol) {
   // Capped cylinder: combine the radial and the axial distance like a 2-D box.
   const std::array<Real, 2> q2 = {q[0], std::max(q[1], q[2])};
   out.distance = CombineBox(q2);
-  if (out.distance <= tol) ActiveFaces(q, n, face, tol, out);
+  if (out.distance <= tol) ActiveFaces(q, n, face, tol, buried, out);
   return out;
 }
 
 // Signed distance to a simple polygon in the xy plane with the edges within tol of the nearest.
-SurfaceQuery QueryPolygon(const PolygonShape& s, const Vec3& p, int dim, Real tol) {
+SurfaceQuery QueryPolygon(const PolygonShape& s, const Vec3& p, int dim, Real tol,
+                          uint64_t buried) {
   const auto& P = s.points;
   const int m = static_cast<int>(P.size());
   Real area2 = 0;  // twice the signed area: > 0 counter-clockwise
@@ -151,12 +158,20 @@ SurfaceQuery QueryPolygon(const PolygonShape& s, const Vec3& p, int dim, Real to
   out.distance = CombineBox(q2);
   if (out.distance > tol) return out;
   out.count = 0;
-  const Real qmax = std::max(q_xy, q2[1]);
-  // Edges: every edge whose distance equals the nearest (within tol) when the xy part is the
-  // largest; its outward normal is the edge normal rotated away from the interior.
-  if (q_xy >= qmax - tol) {
+  // Active faces among the exposed ones (buried faces never act): the nearest exposed edge and
+  // the z caps, whichever is nearest, with ties.
+  Real best_exposed = kInf;
+  for (int k = 0; k < m; ++k)
+    if (!Buried(buried, k)) best_exposed = std::min(best_exposed, edge_distance(k));
+  const Real q_edge = best_exposed < kInf ? (inside ? -best_exposed : best_exposed) : -kInf;
+  const Real q_zlo = Buried(buried, m) ? -kInf : q_lo;
+  const Real q_zhi = Buried(buried, m + 1) ? -kInf : q_hi;
+  const Real qmax = std::max({q_edge, q_zlo, q_zhi});
+  // Edges: every exposed edge whose distance equals the nearest (within tol) when the xy part
+  // is the largest; its outward normal is the edge normal rotated away from the interior.
+  if (q_edge > -kInf && q_edge >= qmax - tol) {
     for (int k = 0; k < m && out.count < kMaxContactFaces; ++k) {
-      if (edge_distance(k) - best > tol) continue;
+      if (Buried(buried, k) || edge_distance(k) - best_exposed > tol) continue;
       const auto& a = P[k];
       const auto& b = P[(k + 1) % m];
       Vec3 nk(orient * (b[1] - a[1]), -orient * (b[0] - a[0]), 0);
@@ -165,11 +180,11 @@ SurfaceQuery QueryPolygon(const PolygonShape& s, const Vec3& p, int dim, Real to
       ++out.count;
     }
   }
-  if (dim == 3 && q_lo >= qmax - tol && out.count < kMaxContactFaces) {
+  if (dim == 3 && q_zlo > -kInf && q_zlo >= qmax - tol && out.count < kMaxContactFaces) {
     out.normal[out.count] = -Vec3::UnitZ();
     out.face[out.count++] = m;
   }
-  if (dim == 3 && q_hi >= qmax - tol && out.count < kMaxContactFaces) {
+  if (dim == 3 && q_zhi > -kInf && q_zhi >= qmax - tol && out.count < kMaxContactFaces) {
     out.normal[out.count] = Vec3::UnitZ();
     out.face[out.count++] = m + 1;
   }
@@ -214,10 +229,13 @@ SurfaceQuery QueryObstacle(const Obstacle& obstacle, const ObstaclePose& pose, c
       [&](const auto& s) -> SurfaceQuery {
         using S = std::decay_t<decltype(s)>;
         if constexpr (std::is_same_v<S, PlaneShape>) return QueryPlane(s, p, tolerance);
-        else if constexpr (std::is_same_v<S, BoxShape>) return QueryBox(s, p, dim, tolerance);
+        else if constexpr (std::is_same_v<S, BoxShape>)
+          return QueryBox(s, p, dim, tolerance, obstacle.buried_faces);
         else if constexpr (std::is_same_v<S, SphereShape>) return QuerySphere(s, p, dim, tolerance);
-        else if constexpr (std::is_same_v<S, CylinderShape>) return QueryCylinder(s, p, tolerance);
-        else if constexpr (std::is_same_v<S, PolygonShape>) return QueryPolygon(s, p, dim, tolerance);
+        else if constexpr (std::is_same_v<S, CylinderShape>)
+          return QueryCylinder(s, p, tolerance, obstacle.buried_faces);
+        else if constexpr (std::is_same_v<S, PolygonShape>)
+          return QueryPolygon(s, p, dim, tolerance, obstacle.buried_faces);
         else return QueryMesh(s, p, tolerance, band);
       },
       obstacle.shape);
@@ -239,7 +257,10 @@ void ReferenceBounds(const ObstacleShape& shape, int dim, Vec3& lo, Vec3& hi) {
           lo = s.center - Vec3::Constant(s.radius);
           hi = s.center + Vec3::Constant(s.radius);
         } else if constexpr (std::is_same_v<S, CylinderShape>) {
-          const Vec3 r = Vec3::Constant(s.radius);
+          // The end disks' extent along world axis i is r sqrt(1 - a_i^2), a the unit axis.
+          const Vec3 a = (s.top - s.base).normalized();
+          Vec3 r;
+          for (int i = 0; i < 3; ++i) r[i] = s.radius * std::sqrt(std::max(0.0, 1 - a[i] * a[i]));
           lo = s.base.cwiseMin(s.top) - r;
           hi = s.base.cwiseMax(s.top) + r;
         } else if constexpr (std::is_same_v<S, PolygonShape>) {
@@ -288,6 +309,55 @@ void PosedBounds(const Obstacle& obstacle, const ObstaclePose& pose, Vec3& lo, V
     lo.z() = -kInf;
     hi.z() = kInf;
   }
+}
+
+uint64_t BuriedFaces(const ObstacleShape& shape, int dim, const Vec3& lo, const Vec3& hi, Real tol) {
+  // A planar face with outward normal n at a point x is buried when n = -e_a and x_a <= lo_a, or
+  // n = +e_a and x_a >= hi_a (nothing can reach it from inside the domain).
+  auto buried = [&](const Vec3& n, const Vec3& x) {
+    for (int a = 0; a < dim; ++a) {
+      if (std::abs(std::abs(n[a]) - 1) > 1e-12) continue;
+      return n[a] < 0 ? x[a] <= lo[a] + tol : x[a] >= hi[a] - tol;
+    }
+    return false;
+  };
+  uint64_t mask = 0;
+  auto mark = [&](int face, bool b) {
+    if (b && face < 64) mask |= uint64_t(1) << face;
+  };
+  std::visit(
+      [&](const auto& s) {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, BoxShape>) {
+          for (int a = 0; a < dim; ++a) {
+            mark(2 * a, buried(-Vec3::Unit(a), s.min));
+            mark(2 * a + 1, buried(Vec3::Unit(a), s.max));
+          }
+        } else if constexpr (std::is_same_v<S, CylinderShape>) {
+          const Vec3 a = (s.top - s.base).normalized();
+          mark(1, buried(-a, s.base));
+          mark(2, buried(a, s.top));
+        } else if constexpr (std::is_same_v<S, PolygonShape>) {
+          const auto& P = s.points;
+          const int m = static_cast<int>(P.size());
+          Real area2 = 0;
+          for (int k = 0; k < m; ++k)
+            area2 += P[k][0] * P[(k + 1) % m][1] - P[(k + 1) % m][0] * P[k][1];
+          const Real orient = area2 > 0 ? 1 : -1;
+          for (int k = 0; k < m; ++k) {
+            const auto& a = P[k];
+            const auto& b = P[(k + 1) % m];
+            const Vec3 n = Vec3(orient * (b[1] - a[1]), -orient * (b[0] - a[0]), 0).normalized();
+            mark(k, buried(n, Vec3(a[0], a[1], 0)));
+          }
+          if (dim == 3) {
+            mark(m, buried(-Vec3::UnitZ(), Vec3(0, 0, s.z0)));
+            mark(m + 1, buried(Vec3::UnitZ(), Vec3(0, 0, s.z1)));
+          }
+        }
+      },
+      shape);
+  return mask;
 }
 
 std::vector<std::string> FaceNames(const ObstacleShape& shape, int dim) {

@@ -48,6 +48,11 @@ SurfaceQuery QueryObstacle(const Obstacle& obstacle, const ObstaclePose& pose, c
 // World bounding box of the obstacle at `pose` (+-infinity for planes).
 void PosedBounds(const Obstacle& obstacle, const ObstaclePose& pose, Vec3& lo, Vec3& hi);
 
+// Obstacle::buried_faces of a fixed shape: the planar faces whose outward normal is a coordinate
+// direction and which lie on or beyond that side of the domain box [lo, hi] (within tol), e.g. a
+// barrier's foot standing on the floor. Planes and meshes have none.
+uint64_t BuriedFaces(const ObstacleShape& shape, int dim, const Vec3& lo, const Vec3& hi, Real tol);
+
 // Face names of a shape (Obstacle::faces) and its bounds at t = 0; used by the scene builder.
 std::vector<std::string> FaceNames(const ObstacleShape& shape, int dim);
 void ReferenceBounds(const ObstacleShape& shape, int dim, Vec3& lo, Vec3& hi);

@@ -3,6 +3,7 @@
 // form) and mesh_distance.cpp (triangle meshes, FCL); the node contact in contact.cpp.
 #pragma once
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <variant>
@@ -60,6 +61,8 @@ struct ObstacleMotion {
 struct ObstacleContact {
   Real friction = 0;      // Coulomb coefficient mu [-]
   bool separable = true;  // false: sticky (bilateral in the normal direction)
+  Real adhesion = 0;      // separable only: tensile strength of the contact [Pa]; a node is
+                          // released once pulling it back would need more than adhesion x h^(d-1)
 };
 
 struct Obstacle {
@@ -69,8 +72,19 @@ struct Obstacle {
   ObstacleContact contact;
   Vec3 reference_point = Vec3::Zero();  // torque is taken about this point (moves with the body) [m]
   std::vector<std::string> faces;       // face names, in the order of ObstacleForce::faces
+  // Bit k set: face k lies on or beyond the domain boundary (a barrier's foot on the floor) and
+  // never acts, so material running up the exposed face next to it is not blocked there.
+  uint64_t buried_faces = 0;
   Vec3 bounds_min = Vec3::Zero();       // world AABB at t = 0 [m] (planes: +-infinity)
   Vec3 bounds_max = Vec3::Zero();
+};
+
+// A force sensor: an axis-aligned box on the grid that sums the reactions of every structure
+// (domain walls and obstacles) at the grid nodes inside it (issue #5), e.g. one strip of a wall.
+struct Sensor {
+  std::string name;          // [A-Za-z0-9_-]+, unique among obstacles and sensors
+  Vec3 min = Vec3::Zero();   // [m] (2-D: z ignored)
+  Vec3 max = Vec3::Zero();   // [m]
 };
 
 }  // namespace surge

@@ -83,6 +83,7 @@ struct Model {
   std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none
   std::vector<BodyInfo> bodies;
   std::vector<Obstacle> obstacles;       // rigid structures (src/contact), in scene order
+  std::vector<Sensor> sensors;           // force sensors (src/contact), in scene order
   OutputPlan output;
 };
 

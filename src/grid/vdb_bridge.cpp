@@ -85,6 +85,7 @@ void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid) 
   grid.force.assign(nodes, Vec3::Zero());
   grid.velocity.resize(nodes);
   grid.velocity_new.resize(nodes);
+  grid.reaction.resize(nodes);
 }
 
 void LookupBlocks(const SparseGrid& grid, const Vec3i* blocks, size_t n, int32_t* out) {

@@ -119,6 +119,11 @@ Obstacle BuildObstacle(const SceneSpec& spec, size_t index) {
   o.motion.velocity = os.velocity;
   o.motion.angular_velocity = os.angular_velocity_deg * (std::numbers::pi / 180.0);
   o.motion.center = os.center ? *os.center : o.reference_point;
+  // Faces on or beyond the domain boundary never act (a barrier standing on the floor).
+  if (o.motion.kind == ObstacleMotionKind::kFixed) {
+    o.buried_faces = BuriedFaces(o.shape, dim, spec.domain.min, spec.domain.max,
+                                 1e-9 * spec.grid.cell_size);
+  }
   return o;
 }
 
@@ -267,6 +272,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   }
   for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
   for (size_t o = 0; o < spec.obstacles.size(); ++o) model.obstacles.push_back(BuildObstacle(spec, o));
+  for (const SensorSpec& s : spec.sensors) model.sensors.push_back(Sensor{s.name, s.min, s.max});
   model.output.every = spec.output.every;
   model.output.vdb = spec.output.vdb;
   model.output.energy = spec.output.energy;

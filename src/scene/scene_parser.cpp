@@ -817,6 +817,10 @@ ObstacleShapeSpec Parser::ParseObstacleShape(const YAML::Node& n, const std::str
     return mesh;
   }
   // box, sphere, cylinder, polygon: the region shapes.
+  if (kind == "cylinder" && dim_ == 2) {
+    Fail(n.begin()->first, p,
+         "cylinder obstacles are 3-D only (in 2-D a disk is a sphere: {sphere: {center, radius}})");
+  }
   const RegionShape region = ParseRegion(n, path);
   return std::visit([](const auto& r) -> ObstacleShapeSpec {
     if constexpr (std::is_same_v<std::decay_t<decltype(r)>, MeshRegion>) {
@@ -872,9 +876,16 @@ ObstacleSpec Parser::ParseObstacle(const YAML::Node& n, const std::string& path)
   if (n["contact"]) {
     const YAML::Node c = n["contact"];
     const std::string cp = Child(path, "contact");
-    ExpectMap(c, cp, {"friction", "separable"});
+    ExpectMap(c, cp, {"friction", "separable", "adhesion"});
     if (c["friction"]) o.contact.friction = NonNegative(c["friction"], Child(cp, "friction"), "-");
     if (c["separable"]) o.contact.separable = Bool(c["separable"], Child(cp, "separable"));
+    if (c["adhesion"]) {
+      o.contact.adhesion = NonNegative(c["adhesion"], Child(cp, "adhesion"), "Pa");
+      if (!o.contact.separable && o.contact.adhesion > 0) {
+        Fail(c["adhesion"], Child(cp, "adhesion"),
+             "adhesion applies only to separable contact (a sticky contact never releases)");
+      }
+    }
   }
   if (n["reference_point"]) {
     o.reference_point = Vector(n["reference_point"], Child(path, "reference_point"), "m");
@@ -886,7 +897,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
   SceneSpec spec;
   const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
                                         "grid",   "domain",    "materials", "bodies",  "obstacles",
-                                        "output", "parameters"};
+                                        "sensors", "output", "parameters"};
   if (!root.IsDefined() || root.IsNull()) {
     throw SceneError(source_, 0, 0, "", "the scene is empty (expected a map with keys " + Join(top) + ")");
   }
@@ -1002,6 +1013,38 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
         }
       }
       spec.obstacles.push_back(std::move(o));
+    }
+  }
+
+  if (root["sensors"]) {
+    const YAML::Node ss = root["sensors"];
+    if (!ss.IsSequence()) Fail(ss, "sensors", "expected a list of sensors, got " + Describe(ss));
+    for (size_t i = 0; i < ss.size(); ++i) {
+      const std::string sp = Index("sensors", i);
+      ExpectMap(ss[i], sp, {"name", "box"});
+      SensorSpec sensor;
+      sensor.loc = Loc(ss[i], sp);
+      sensor.name = Identifier(Need(ss[i], sp, "name"), Child(sp, "name"));
+      const YAML::Node box = Need(ss[i], sp, "box");
+      const std::string bp = Child(sp, "box");
+      ExpectMap(box, bp, {"min", "max"});
+      sensor.min = Vector(Need(box, bp, "min"), Child(bp, "min"), "m");
+      sensor.max = Vector(Need(box, bp, "max"), Child(bp, "max"), "m");
+      for (int a = 0; a < dim_; ++a) {
+        if (!(sensor.max[a] >= sensor.min[a])) {
+          Fail(box["max"], Child(bp, "max"), "must not be below min in any component [m]");
+        }
+      }
+      // One namespace with the obstacles: they share the force log.
+      std::vector<std::string> taken = {"domain"};
+      for (const ObstacleSpec& o : spec.obstacles) taken.push_back(o.name);
+      for (const SensorSpec& o : spec.sensors) taken.push_back(o.name);
+      if (std::find(taken.begin(), taken.end(), sensor.name) != taken.end()) {
+        Fail(ss[i]["name"], Child(sp, "name"),
+             "the name '" + sensor.name +
+                 "' is taken (by 'domain', an obstacle or another sensor: they share the force log)");
+      }
+      spec.sensors.push_back(std::move(sensor));
     }
   }
 
@@ -1171,7 +1214,8 @@ void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
   }
   e << YAML::Key << "contact" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
     << "friction" << YAML::Value << Num(o.contact.friction) << YAML::Key << "separable"
-    << YAML::Value << o.contact.separable << YAML::EndMap;
+    << YAML::Value << o.contact.separable << YAML::Key << "adhesion" << YAML::Value
+    << Num(o.contact.adhesion) << YAML::EndMap;
   if (o.reference_point) {
     e << YAML::Key << "reference_point" << YAML::Value;
     EmitVector(e, *o.reference_point, dim);
@@ -1289,6 +1333,19 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   if (!spec.obstacles.empty()) {
     e << YAML::Key << "obstacles" << YAML::Value << YAML::BeginSeq;
     for (const ObstacleSpec& o : spec.obstacles) EmitObstacle(e, o, dim);
+    e << YAML::EndSeq;
+  }
+
+  if (!spec.sensors.empty()) {
+    e << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
+    for (const SensorSpec& s : spec.sensors) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << s.name
+        << YAML::Key << "box" << YAML::Value << YAML::BeginMap << YAML::Key << "min" << YAML::Value;
+      EmitVector(e, s.min, dim);
+      e << YAML::Key << "max" << YAML::Value;
+      EmitVector(e, s.max, dim);
+      e << YAML::EndMap << YAML::EndMap;
+    }
     e << YAML::EndSeq;
   }
 

@@ -204,6 +204,13 @@ struct ObstacleSpec {
   SourceLoc shape_loc;
 };
 
+struct SensorSpec {  // a force sensor box (contact/obstacle.h Sensor)
+  std::string name;
+  Vec3 min = Vec3::Zero();  // [m]
+  Vec3 max = Vec3::Zero();  // [m]
+  SourceLoc loc;
+};
+
 struct OutputSpec {
   Real every = 0;  // [s]; 0 = first and last only
   bool vdb = false;
@@ -221,6 +228,7 @@ struct SceneSpec {
   std::vector<MaterialSpec> materials;  // in file order; Model::materials has the same order
   std::vector<BodySpec> bodies;
   std::vector<ObstacleSpec> obstacles;  // in file order; Model::obstacles has the same order
+  std::vector<SensorSpec> sensors;      // in file order; Model::sensors has the same order
   OutputSpec output;
   // `parameters:` in file order, after --set overrides; `${expr}` values were evaluated over
   // them before validation (scene_expressions.h).

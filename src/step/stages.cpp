@@ -32,9 +32,13 @@ void ObstacleContactStage(const Model& m, const StepContext& c, State&, Workspac
   ApplyObstacleContact(m, c, w.grid, w.contact, &r.obstacles);
 }
 
+void SensorsStage(const Model& m, const StepContext& c, State&, Workspace& w, StepReport& r) {
+  SumSensors(m, c, w.grid, w.contact, r.sensors);
+}
+
 void ObstacleProjectionStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                              StepReport& r) {
-  ProjectParticlesOutOfObstacles(m, c, s.particles, w.contact, &r.obstacles);
+  ProjectParticlesOutOfObstacles(m, c, w.grid, s.particles, w.contact, &r.obstacles);
 }
 
 void GridToParticleUslStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -97,12 +101,13 @@ std::vector<ForceChannel> ForceChannels(const Model& m) {
     channels.push_back(std::move(domain));
   }
   for (const Obstacle& o : m.obstacles) channels.push_back({o.name, o.faces});
+  for (const Sensor& s : m.sensors) channels.push_back({s.name, {}});
   return channels;
 }
 
 void CollectForces(const Model& m, const StepReport& step, ContactReport& out) {
   const std::vector<int> walled = WalledFaces(m);
-  out.structures.resize((walled.empty() ? 0 : 1) + m.obstacles.size());
+  out.structures.resize((walled.empty() ? 0 : 1) + m.obstacles.size() + m.sensors.size());
   size_t k = 0;
   if (!walled.empty()) {
     ObstacleForce& d = out.structures[k++];
@@ -134,6 +139,9 @@ void CollectForces(const Model& m, const StepReport& step, ContactReport& out) {
   }
   for (size_t o = 0; o < m.obstacles.size(); ++o) {
     out.structures[k++] = o < step.obstacles.size() ? step.obstacles[o] : ObstacleForce{};
+  }
+  for (size_t s = 0; s < m.sensors.size(); ++s) {
+    out.structures[k++] = s < step.sensors.size() ? step.sensors[s] : ObstacleForce{};
   }
 }
 

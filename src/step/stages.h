@@ -14,6 +14,8 @@ void ParticleToGridStage(const Model&, const StepContext&, State&, Workspace&, S
 void GridUpdateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Node contact with the rigid obstacles on v_{n+1} (src/contact), reactions into the report.
 void ObstacleContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// Force sensors: node reactions summed over each sensor box (src/contact).
+void SensorsStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Particles that ended inside an obstacle go back to its surface (src/contact).
 void ObstacleProjectionStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridToParticleUslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
@@ -31,7 +33,7 @@ void CheckStateStage(const Model&, const StepContext&, State&, Workspace&, StepR
 void EnergyStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 
 // What the force log records (DESIGN §7): "domain" (the walled faces) when a wall is not open,
-// then every obstacle with its faces.
+// then every obstacle with its faces, then every force sensor (no faces).
 std::vector<ForceChannel> ForceChannels(const Model& model);
 // The step's reactions in ForceChannels order.
 void CollectForces(const Model& model, const StepReport& step, ContactReport& out);

@@ -40,6 +40,7 @@ Pipeline MakePipeline(const Model& model) {
     p.push_back({Stage::kVelocityGradient, VelocityGradientStage});            // (2.17)
   }
   if (obstacles) p.push_back({Stage::kObstacleProjection, ObstacleProjectionStage});
+  if (!model.sensors.empty()) p.push_back({Stage::kSensors, SensorsStage});  // all reactions in
   if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
   p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)
   p.push_back({Stage::kDomainExit, DomainExitStage});

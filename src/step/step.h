@@ -20,6 +20,7 @@ struct StepReport {
   Health health;                 // first problem found by CheckState / DomainExit / time step
   WallReport walls;              // wall reactions of the last step
   std::vector<ObstacleForce> obstacles;  // obstacle reactions of the last step (Model order)
+  std::vector<ObstacleForce> sensors;    // force-sensor sums of the last step (Model order)
   int64_t removed_last_step = 0; // particles removed through open sides in the last step
 };
 

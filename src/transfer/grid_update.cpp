@@ -96,6 +96,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
       if (m <= 0) {
         grid.velocity[i].setZero();
         grid.velocity_new[i].setZero();
+        grid.reaction[i].setZero();
         continue;
       }
       const Vec3 v = grid.momentum[i] / m;                        // (2.13)
@@ -128,6 +129,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
         }
       }
       grid.velocity_new[i] = vc;
+      grid.reaction[i] = m * (vu - vc) / ctx.dt;  // on the walls; zero away from them
     }
   });
   report = WallReport{};

@@ -37,7 +37,8 @@ struct WallReport {
 
 // Grid solve (2.13)-(2.14) and domain walls (seed Planar / Fixed nodes, spec §5.3): v_n = p/m,
 // v_{n+1} = v_n + dt (f/m + g), then the wall constraints on v_{n+1}. Nodes with no mass get
-// zero velocity. Reads mass, momentum, force. Writes velocity, velocity_new, report.
+// zero velocity. Reads mass, momentum, force. Writes velocity, velocity_new, reaction (the
+// walls' share), report.
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report);
 

@@ -27,7 +27,23 @@ constexpr const char* kSmoothCap =
     "{model: drucker_prager_smooth_cap, density: 1950.55, bulk_modulus: 8.33e6, "
     "shear_modulus: 3.85e6, friction_angle_deg: 20, yield_stress: 10, associativity: 0.05}";
 
-std::string BlockScene(const char* shape, const char* transfer, const char* material) {
+// Obstacles in the block's path (it flies towards +x at 2 m/s and starts 0.017 m from them): a
+// box wall, and the project's mound mesh scaled to 1.8 m x 0.9 m, lying on its side with its
+// top 0.067 m ahead of the block (FCL distance queries).
+constexpr const char* kNoObstacles = "";
+constexpr const char* kBoxObstacle = R"(obstacles:
+  - name: wall
+    shape: {box: {min: [0.95, -2, -2], max: [1.5, 3, 3]}}
+    contact: {friction: 0.3}
+)";
+const std::string kMeshObstacle = std::string(R"(obstacles:
+  - name: mound
+    shape: {mesh: {file: )") + SURGE_SOURCE_DIR + R"(/assets/mound.obj, scale: 0.3, rotate_deg: [0, 0, 90], translate: [1.9, 0.45, 0.45]}}
+    contact: {friction: 0.3}
+)";
+
+std::string BlockScene(const char* shape, const char* transfer, const char* material,
+                       const std::string& obstacles = kNoObstacles) {
   return std::string(R"(name: bench_block
 dimension: 3
 time: {end: 100.0, cfl: 0.4}
@@ -44,14 +60,15 @@ bodies:
     particles_per_cell: 2
     velocity: [2.0, 1.0, 0.5]
 output: {every: 0, energy: false}
-)";
+)" + obstacles;
 }
 
 void BM_Step(benchmark::State& bm, const char* shape, const char* transfer,
-             const char* material = kRubber) {
+             const char* material = kRubber, const std::string& obstacles = kNoObstacles) {
   const int threads = int(bm.range(0));
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  LoadedScene scene = LoadSceneFromString(BlockScene(shape, transfer, material), "bench_block.yaml");
+  LoadedScene scene = LoadSceneFromString(BlockScene(shape, transfer, material, obstacles),
+                                          "bench_block.yaml");
   const Pipeline pipeline = MakePipeline(scene.model);
   Workspace work;
   StepReport report;
@@ -84,6 +101,14 @@ BENCHMARK_CAPTURE(BM_Step, quadratic_apic_modified_dp, "quadratic_bspline", "api
 BENCHMARK_CAPTURE(BM_Step, quadratic_apic_smooth_cap, "quadratic_bspline", "apic", kSmoothCap)
     ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 BENCHMARK_CAPTURE(BM_Step, quadratic_apic_mn_dp, "quadratic_bspline", "apic", kMatsuokaNakaiDp)
+    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+// Rigid obstacles in the block's path: the cost of the node contact and the particle projection
+// (stages obstacle_contact, obstacle_projection) on top of the plain block.
+BENCHMARK_CAPTURE(BM_Step, quadratic_apic_box_obstacle, "quadratic_bspline", "apic", kRubber,
+                  kBoxObstacle)
+    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_Step, quadratic_apic_mesh_obstacle, "quadratic_bspline", "apic", kRubber,
+                  kMeshObstacle)
     ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 }  // namespace

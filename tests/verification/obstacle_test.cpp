@@ -62,6 +62,9 @@ bodies:
 obstacles:
   - name: wall
     shape: {box: {min: [0.1, 0], max: [0.16, 0.12]}}
+sensors:
+  - {name: lower, box: {min: [0.099, 0], max: [0.16, 0.03]}}
+  - {name: upper, box: {min: [0.099, 0.03], max: [0.16, 0.12]}}
 )";
 
 TEST(ObstacleTest, HydrostaticThrustOnObstacleBoxAndDomainWall) {
@@ -69,18 +72,40 @@ TEST(ObstacleTest, HydrostaticThrustOnObstacleBoxAndDomainWall) {
   LoadedScene scene = LoadSceneFromString(kTankScene, "tank_obstacle.yaml");
   const Real mass = TotalMass(scene.state.particles);
   const Real h = mass / (kRho * kW);
-  Real box = 0, wall = 0, floor_obstacle = 0;
+  Real box = 0, wall = 0, floor_obstacle = 0, lower = 0, upper = 0, sensor_gap = 0;
   int n = 0;
   testing::RunUntil(scene, 1.0, [&](const State& s, const StepReport& r) {
     if (s.time < kAvgFrom) return;
     box += r.obstacles.at(0).force.x();                  // pushed towards +x
     wall += -r.walls.force[int(Face::kXMin)].x();         // domain wall x-: pushed towards -x
     floor_obstacle += r.obstacles.at(0).force.y();
+    lower += r.sensors.at(0).force.x();
+    upper += r.sensors.at(1).force.x();
+    // The two sensors cover every obstacle node once: their sum is the obstacle's force.
+    sensor_gap = std::max(sensor_gap, std::abs(r.sensors.at(0).force.x() +
+                                               r.sensors.at(1).force.x() -
+                                               r.obstacles.at(0).force.x()));
     ++n;
   });
   box /= n;
   wall /= n;
   floor_obstacle /= n;
+  lower /= n;
+  upper /= n;
+  // Force sensors: the hydrostatic load below and above y = 0.03 m, integral of rho g (h - y).
+  const Real lower_expected = kRho * kG * (h * 0.03 - 0.5 * 0.03 * 0.03);
+  const Real upper_expected = 0.5 * kRho * kG * h * h - lower_expected;
+  std::printf("sensors: lower strip %.3f N/m (closed form %.3f, %+.2f %%), upper strip %.3f N/m "
+              "(closed form %.3f, %+.2f %%)\n",
+              lower, lower_expected, 100 * (lower / lower_expected - 1), upper, upper_expected,
+              100 * (upper / upper_expected - 1));
+  std::printf("sensors: largest |lower + upper - obstacle| over the averaging window %.3g N/m\n",
+              sensor_gap);
+  EXPECT_LT(sensor_gap, 1e-9 * box);
+  EXPECT_NEAR(lower, lower_expected, 0.03 * lower_expected);
+  // The upper strip carries the whole -1.8 % deficit of the total (-6 % of its own load): near the
+  // free surface the stress of the top particle layer is spread over a cell by the B-splines.
+  EXPECT_NEAR(upper, upper_expected, 0.08 * upper_expected);
   const Real expected = 0.5 * kRho * kG * h * h;  // per metre of thickness
   std::printf("hydrostatic thrust (h = %.4f m): obstacle box %.3f N/m, domain wall %.3f N/m, "
               "1/2 rho g h^2 = %.3f N/m (errors %+.2f %%, %+.2f %%); vertical force on the box "
@@ -223,6 +248,52 @@ TEST(ObstacleTest, LoggedImpulseEqualsTheMomentumTheDiskLoses) {
   EXPECT_LT((impulse - dp).norm(), 0.01 * dp.norm());
   EXPECT_EQ(penetration, 0);
   EXPECT_LT(std::abs(impulse.x()), 0.05 * std::abs(impulse.y()));  // smooth top face
+}
+
+// --- Adhesion ----------------------------------------------------------------------------------
+// An elastic block (0.2 m x 0.1 m, 1000 kg/m^3: weight 196 N/m) hangs under a plane ceiling. A
+// separable contact releases it; an adhesion of 2000 Pa holds it (about 13 contact nodes x h =
+// 0.26 m can carry 520 N/m); 300 Pa cannot (78 N/m).
+Real HangingBlockDrop(Real adhesion) {
+  const std::string text = R"(name: hanging_block
+dimension: 2
+time: {end: 0.3, cfl: 0.4}
+gravity: [0, -9.81]
+gravity_ramp: 0.05
+grid: {cell_size: 0.02, shape_function: quadratic_bspline, transfer: apic, update: musl}
+domain:
+  min: [0, 0]
+  max: [1, 0.6]
+materials:
+  rubber: {model: neo_hookean, density: 1000, youngs_modulus: 2.0e6, poisson_ratio: 0.3}
+bodies:
+  - name: block
+    material: rubber
+    region: {box: {min: [0.4, 0.4], max: [0.6, 0.5]}}
+    particles_per_cell: 2
+obstacles:
+  - name: ceiling
+    shape: {plane: {point: [0, 0.5], normal: [0, -1]}}
+    contact: {adhesion: )" + std::to_string(adhesion) + "}\n";
+  LoadedScene scene = LoadSceneFromString(text, "hanging_block.yaml");
+  auto mean_y = [](const Particles& P) {
+    Real y = 0;
+    for (const Vec3& x : P.x) y += x.y();
+    return y / Real(P.size());
+  };
+  const Real y0 = mean_y(scene.state.particles);
+  testing::RunUntil(scene, 0.3, [](const State&, const StepReport&) {});
+  return y0 - mean_y(scene.state.particles);
+}
+
+TEST(ObstacleTest, AdhesionHoldsAHangingBlockOnlyWhenStrongEnough) {
+  const Real none = HangingBlockDrop(0), weak = HangingBlockDrop(300), strong = HangingBlockDrop(2000);
+  std::printf("hanging block drop after 0.3 s: no adhesion %.4f m, 300 Pa %.4f m, 2000 Pa %.5f m "
+              "(free fall from rest with the 0.05 s ramp: %.3f m)\n",
+              none, weak, strong, 0.5 * 9.81 * 0.275 * 0.275);
+  EXPECT_GT(none, 0.2);
+  EXPECT_GT(weak, 0.1);
+  EXPECT_LT(strong, 0.002);  // elastic sag only
 }
 
 }  // namespace

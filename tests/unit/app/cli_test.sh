@@ -72,6 +72,8 @@ else
   echo "FAIL run_obstacle_csv: forces_fin.csv / forces_domain.csv missing or without header"; fail=$((fail + 1))
 fi
 expect check_obstacle_named_domain 2 'obstacles\[0\]\.name.*reserved' -- "$surge" check "$work/obstacles.yaml" --set "obstacles.0.name=domain"
+expect check_geostatic_ramp 0 "bodies\[0\] 'surge': starts with a geostatic stress while gravity_ramp" -- "$surge" check "$src/scenes/column_impact_3d.yaml" --set gravity_ramp=0.2
+expect check_cylinder_2d 2 'cylinder obstacles are 3-D only' -- "$surge" check "$work/obstacles.yaml" --set "obstacles.1.shape={cylinder: {base: [0.6, 0], top: [0.6, 0.5], radius: 0.05}}"
 expect bad_option 2 '' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --threads 0
 expect no_subcommand 2 '' -- "$surge"
 expect run_small 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out" --set time.end=0.2 --threads 2 --progress plain
