@@ -72,7 +72,8 @@ Vec3 UpDirection(const Model& model) {
   return g > 0 ? Vec3(-model.gravity / g) : Vec3::UnitY();
 }
 
-void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid& grid,
+void ApplyObstacleContact(const Model& model, const StepContext& ctx,
+                          const std::vector<RigidBodyState>& rigid, SparseGrid& grid,
                           ContactScratch& scratch, std::vector<ObstacleForce>* report) {
   const Real t1 = ctx.time + ctx.dt;  // the constraint acts on v_{n+1}
   const Real tol = 1e-9 * ctx.dx;     // node-on-surface test, robust to round-off of i*dx
@@ -83,7 +84,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
   scratch.near_block.assign(nb, 0);
   for (size_t o = 0; o < model.obstacles.size(); ++o) {
     const Obstacle& ob = model.obstacles[o];
-    const ObstaclePose pose = PoseAt(ob, t1);
+    const ObstaclePose pose = PoseAt(ob, t1, &rigid);
     // Broad phase: blocks whose node box meets the obstacle's posed bounds.
     Vec3 lo, hi;
     PosedBounds(ob, pose, lo, hi);
@@ -241,6 +242,7 @@ void SumSensors(const Model& model, const StepContext& ctx, const SparseGrid& gr
 }
 
 int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ctx,
+                                       const std::vector<RigidBodyState>& rigid,
                                        SparseGrid& grid, Particles& P,
                                        ContactScratch& scratch, std::vector<ObstacleForce>* report) {
   const Real t1 = ctx.time + ctx.dt;  // positions are x_{n+1}
@@ -252,7 +254,7 @@ int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ct
   hi.resize(no);
   ref.resize(no);
   for (size_t o = 0; o < no; ++o) {
-    poses[o] = PoseAt(model.obstacles[o], t1);
+    poses[o] = PoseAt(model.obstacles[o], t1, &rigid);
     PosedBounds(model.obstacles[o], poses[o], lo[o], hi[o]);
     ref[o] = poses[o].ToWorld(model.obstacles[o].reference_point);
   }

@@ -35,13 +35,15 @@ struct ContactScratch {
   std::vector<Vec3> lo, hi, ref;       // posed bounds and reference points
 };
 
-// For every obstacle in Model order, at its pose at t_{n+1} = ctx.time + ctx.dt: each grid node
+// For every obstacle in Model order, at its pose at t_{n+1} = ctx.time + ctx.dt (dynamic
+// obstacles: their state in `rigid`, State::rigid, i.e. at t_n: explicit coupling): each grid node
 // with mass on or inside it (signed distance <= 1e-9 h) gets, relative to the obstacle's
 // velocity there, its approaching normal velocity removed on every active face (all of it when
 // the contact is not separable) and Coulomb friction |dv_t| <= mu |dv_n| on the tangential part.
 // Writes grid.velocity_new. When `report` is non-null, (*report)[o] receives obstacle o's force
 // (sum of m (v_before - v_after) / dt), torque, contact area, wetted height, per-face sums.
-void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid& grid,
+void ApplyObstacleContact(const Model& model, const StepContext& ctx,
+                          const std::vector<RigidBodyState>& rigid, SparseGrid& grid,
                           ContactScratch& scratch, std::vector<ObstacleForce>* report);
 
 // After the position update: a particle found inside an obstacle (possible within half a cell
@@ -55,6 +57,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx, SparseGrid
 // inside lies within half a cell of the surface, so a node of its stencil lies within 2 h of it.
 // Returns the number of particles moved.
 int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ctx,
+                                       const std::vector<RigidBodyState>& rigid,
                                        SparseGrid& grid, Particles& particles,
                                        ContactScratch& scratch, std::vector<ObstacleForce>* report);
 

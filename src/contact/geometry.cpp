@@ -206,12 +206,21 @@ SurfaceQuery QueryMesh(const MeshShape& s, const Vec3& p, Real tol, Real band) {
 
 }  // namespace
 
-ObstaclePose PoseAt(const Obstacle& obstacle, Real t) {
+ObstaclePose PoseAt(const Obstacle& obstacle, Real t, const std::vector<RigidBodyState>* rigid) {
   const ObstacleMotion& m = obstacle.motion;
   ObstaclePose pose;
   pose.center0 = m.center;
   pose.center = m.center;
   if (m.kind == ObstacleMotionKind::kFixed) return pose;
+  if (m.kind == ObstacleMotionKind::kDynamic) {
+    if (rigid == nullptr || m.body < 0 || size_t(m.body) >= rigid->size()) return pose;
+    const RigidBodyState& s = (*rigid)[size_t(m.body)];
+    pose.center = s.position;
+    pose.rotation = s.rotation;
+    pose.velocity = s.velocity;
+    pose.angular_velocity = s.angular_velocity;
+    return pose;
+  }
   pose.velocity = m.velocity;
   pose.angular_velocity = m.angular_velocity;
   pose.center = m.center + t * m.velocity;

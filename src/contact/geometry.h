@@ -3,6 +3,7 @@
 // (geometry.cpp); meshes go through MeshDistanceField (mesh_distance.cpp, FCL).
 #pragma once
 #include <array>
+#include <vector>
 
 #include "contact/obstacle.h"
 #include "core/math.h"
@@ -23,8 +24,10 @@ struct ObstaclePose {
   Vec3 PointVelocity(const Vec3& x) const { return velocity + angular_velocity.cross(x - center); }
 };
 
-// Pose of a fixed or prescribed obstacle at time t (obstacle.h ObstacleMotion).
-ObstaclePose PoseAt(const Obstacle& obstacle, Real t);
+// Pose of an obstacle at time t (obstacle.h ObstacleMotion). A dynamic obstacle's pose is its
+// entry of `rigid` (State::rigid), whatever t; without `rigid` it is the reference pose.
+ObstaclePose PoseAt(const Obstacle& obstacle, Real t,
+                    const std::vector<RigidBodyState>* rigid = nullptr);
 
 // Up to three faces act at one point: edges and corners of boxes, cylinder rims, polygon
 // vertices (seed spec §5.2 [REC]: constrain the span of all active normals, keep each face's

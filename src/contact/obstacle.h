@@ -46,14 +46,30 @@ struct MeshShape {  // triangle mesh (3-D), after scale / rotation / translation
 using ObstacleShape =
     std::variant<PlaneShape, BoxShape, SphereShape, CylinderShape, PolygonShape, MeshShape>;
 
-enum class ObstacleMotionKind { kFixed, kPrescribed };
+enum class ObstacleMotionKind { kFixed, kPrescribed, kDynamic };
 
 // Prescribed rigid motion: x(t) = c(t) + R(t) (x0 - c0), c(t) = c0 + v t, R(t) = exp(t [omega]x).
+// Dynamic (Bullet, src/rigid): the same map with c(t), R(t) and the velocities taken from the
+// body's RigidBodyState in State::rigid; c0 is the reference point.
 struct ObstacleMotion {
   ObstacleMotionKind kind = ObstacleMotionKind::kFixed;
-  Vec3 velocity = Vec3::Zero();          // v [m/s]
-  Vec3 angular_velocity = Vec3::Zero();  // omega [rad/s] (2-D: z component only)
-  Vec3 center = Vec3::Zero();            // c0: centre of rotation at t = 0 [m]
+  Vec3 velocity = Vec3::Zero();          // v [m/s] (dynamic: initial)
+  Vec3 angular_velocity = Vec3::Zero();  // omega [rad/s] (2-D: z component only; dynamic: initial)
+  Vec3 center = Vec3::Zero();            // c0: centre of rotation (dynamic: of mass) at t = 0 [m]
+  // Dynamic only (exactly one of mass and density is > 0).
+  int body = -1;          // index into State::rigid
+  Real mass = 0;          // [kg]
+  Real density = 0;       // [kg/m^3]: mass = density x volume of the shape (Bullet shape)
+  Real restitution = 0;   // Bullet collisions with other rigid bodies and walls [-]
+};
+
+// State of a dynamic obstacle (part of State: a checkpoint holds it), for its reference point
+// c0 = ObstacleMotion::center (which is also its Obstacle::reference_point).
+struct RigidBodyState {
+  Vec3 position = Vec3::Zero();          // where c0 is now, c(t) [m]
+  Mat3 rotation = Mat3::Identity();      // R(t), relative to the reference pose at t = 0
+  Vec3 velocity = Vec3::Zero();          // of that point [m/s]
+  Vec3 angular_velocity = Vec3::Zero();  // world frame [rad/s]
 };
 
 // Node contact law (Bardenhagen et al. 2000, eq. (11); Anura3D manual §6.2): no penetration,

@@ -15,6 +15,7 @@ enum class Stage : int {
   kRemapMomentum,      // MUSL only
   kVelocityGradient,   // MUSL only
   kObstacleProjection, // only with obstacles: particles inside an obstacle back to its surface
+  kRigidBodies,        // only with dynamic obstacles: MPM reactions -> Bullet step (src/rigid)
   kSensors,            // only with force sensors (src/contact)
   kAntiLocking,        // only when a material is anti-locked (src/stabilize)
   kUpdateStress,

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "contact/obstacle.h"
 #include "core/particles.h"
 
 namespace surge {
@@ -23,6 +24,7 @@ struct State {
   std::vector<MaterialGroup> groups;
   int64_t particles_removed = 0;  // particles that left through open domain sides
   Real wall_work = 0;             // cumulative work done on the particles by walls [J]
+  std::vector<RigidBodyState> rigid;  // dynamic obstacles (ObstacleMotion::body), Bullet-stepped
 };
 
 }  // namespace surge

@@ -119,11 +119,18 @@ Obstacle BuildObstacle(const SceneSpec& spec, size_t index) {
   o.motion.velocity = os.velocity;
   o.motion.angular_velocity = os.angular_velocity_deg * (std::numbers::pi / 180.0);
   o.motion.center = os.center ? *os.center : o.reference_point;
-  // Faces on or beyond the domain boundary never act (a barrier standing on the floor).
-  if (o.motion.kind == ObstacleMotionKind::kFixed) {
-    o.buried_faces = BuriedFaces(o.shape, dim, spec.domain.min, spec.domain.max,
-                                 1e-9 * spec.grid.cell_size);
+  if (os.motion == ObstacleMotionKind::kDynamic) {
+    // The state of a dynamic body is that of its reference point (obstacle.h RigidBodyState).
+    o.motion.center = o.reference_point;
+    o.motion.mass = os.mass;
+    o.motion.density = os.density;
+    o.motion.restitution = os.restitution;
   }
+  // Faces on or beyond the domain boundary at t = 0 never act (a barrier standing on the floor,
+  // a body spanning a slab between slip walls). For a moving obstacle this holds while it slides
+  // along that wall (docs/scene-reference.md).
+  o.buried_faces = BuriedFaces(o.shape, dim, spec.domain.min, spec.domain.max,
+                               1e-9 * spec.grid.cell_size);
   return o;
 }
 
@@ -295,6 +302,12 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   // Lay the particles out grouped by material, bodies in file order within a group: the same
   // order as a stable sort of the seeding order by material index.
   state = State{};
+  for (Obstacle& o : model.obstacles) {  // dynamic bodies start at their reference pose
+    if (o.motion.kind != ObstacleMotionKind::kDynamic) continue;
+    o.motion.body = static_cast<int>(state.rigid.size());
+    state.rigid.push_back(RigidBodyState{o.motion.center, Mat3::Identity(), o.motion.velocity,
+                                         o.motion.angular_velocity});
+  }
   Particles& P = state.particles;
   P.Resize(static_cast<size_t>(total));
   size_t next = 0;

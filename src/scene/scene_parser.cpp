@@ -851,11 +851,36 @@ ObstacleSpec Parser::ParseObstacle(const YAML::Node& n, const std::string& path)
         Fail(m, mp, "a prescribed motion needs its velocities: write {prescribed: {velocity: [..]}}");
       }
       if (m.Scalar() != "fixed") {
-        Fail(m, mp, "unknown motion '" + m.Scalar() + "' (expected fixed or {prescribed: {...}})");
+        Fail(m, mp, "unknown motion '" + m.Scalar() +
+                        "' (expected fixed, {prescribed: {...}} or {dynamic: {...}})");
       }
     } else {
-      ExpectMap(m, mp, {"fixed", "prescribed"});
+      ExpectMap(m, mp, {"fixed", "prescribed", "dynamic"});
       if (m["fixed"]) Fail(m, mp, "write motion: fixed (a plain value)");
+      if (m.size() != 1) Fail(m, mp, "expected exactly one of: prescribed, dynamic");
+      if (m["dynamic"]) {
+        const YAML::Node dn = m["dynamic"];
+        const std::string dp = Child(mp, "dynamic");
+        if (dim_ == 2) Fail(m.begin()->first, dp, "dynamic obstacles are 3-D only (Bullet bodies)");
+        if (std::holds_alternative<PlaneShape>(o.shape)) {
+          Fail(m.begin()->first, dp, "a plane is infinite and cannot be dynamic");
+        }
+        ExpectMap(dn, dp, {"mass", "density", "velocity", "angular_velocity_deg", "restitution"});
+        o.motion = ObstacleMotionKind::kDynamic;
+        if (dn["mass"].IsDefined() == dn["density"].IsDefined()) {
+          Fail(dn, dp, "give exactly one of mass [kg] and density [kg/m^3]");
+        }
+        if (dn["mass"]) o.mass = Positive(dn["mass"], Child(dp, "mass"), "kg");
+        if (dn["density"]) o.density = Positive(dn["density"], Child(dp, "density"), "kg/m^3");
+        if (dn["velocity"]) o.velocity = Vector(dn["velocity"], Child(dp, "velocity"), "m/s");
+        if (dn["angular_velocity_deg"]) {
+          o.angular_velocity_deg =
+              Vector(dn["angular_velocity_deg"], Child(dp, "angular_velocity_deg"), "deg/s");
+        }
+        if (dn["restitution"]) {
+          o.restitution = Ranged(dn["restitution"], Child(dp, "restitution"), "-", 0, true, 1, true);
+        }
+      } else {
       const YAML::Node pr = Need(m, mp, "prescribed");
       const std::string pp = Child(mp, "prescribed");
       ExpectMap(pr, pp, {"velocity", "angular_velocity_deg", "center"});
@@ -871,6 +896,7 @@ ObstacleSpec Parser::ParseObstacle(const YAML::Node& n, const std::string& path)
         }
       }
       if (pr["center"]) o.center = Vector(pr["center"], Child(pp, "center"), "m");
+      }
     }
   }
   if (n["contact"]) {
@@ -1196,6 +1222,16 @@ void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
   e << YAML::Key << "motion" << YAML::Value;
   if (o.motion == ObstacleMotionKind::kFixed) {
     e << "fixed";
+  } else if (o.motion == ObstacleMotionKind::kDynamic) {
+    e << YAML::BeginMap << YAML::Key << "dynamic" << YAML::Value << YAML::BeginMap;
+    if (o.mass > 0) e << YAML::Key << "mass" << YAML::Value << Num(o.mass);
+    if (o.density > 0) e << YAML::Key << "density" << YAML::Value << Num(o.density);
+    e << YAML::Key << "velocity" << YAML::Value;
+    EmitVector(e, o.velocity, dim);
+    e << YAML::Key << "angular_velocity_deg" << YAML::Value;
+    EmitVector(e, o.angular_velocity_deg, dim);
+    e << YAML::Key << "restitution" << YAML::Value << Num(o.restitution);
+    e << YAML::EndMap << YAML::EndMap;
   } else {
     e << YAML::BeginMap << YAML::Key << "prescribed" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "velocity" << YAML::Value;

@@ -195,8 +195,11 @@ struct ObstacleSpec {
   std::string name;
   ObstacleShapeSpec shape;
   ObstacleMotionKind motion = ObstacleMotionKind::kFixed;
-  Vec3 velocity = Vec3::Zero();              // prescribed [m/s]
-  Vec3 angular_velocity_deg = Vec3::Zero();  // prescribed [deg/s]
+  Vec3 velocity = Vec3::Zero();              // prescribed, or dynamic initial [m/s]
+  Vec3 angular_velocity_deg = Vec3::Zero();  // prescribed, or dynamic initial [deg/s]
+  Real mass = 0;                             // dynamic: [kg] (or density)
+  Real density = 0;                          // dynamic: [kg/m^3] (or mass)
+  Real restitution = 0;                      // dynamic: Bullet collisions [-]
   std::optional<Vec3> center;                // centre of rotation; default: reference point
   ObstacleContact contact;
   std::optional<Vec3> reference_point;       // torque reference; default: centre of the bounds

@@ -27,9 +27,9 @@ void GridUpdateStage(const Model& m, const StepContext& c, State& s, Workspace& 
   s.wall_work += r.walls.work;
 }
 
-void ObstacleContactStage(const Model& m, const StepContext& c, State&, Workspace& w,
+void ObstacleContactStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                           StepReport& r) {
-  ApplyObstacleContact(m, c, w.grid, w.contact, &r.obstacles);
+  ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, &r.obstacles);
 }
 
 void SensorsStage(const Model& m, const StepContext& c, State&, Workspace& w, StepReport& r) {
@@ -38,7 +38,7 @@ void SensorsStage(const Model& m, const StepContext& c, State&, Workspace& w, St
 
 void ObstacleProjectionStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                              StepReport& r) {
-  ProjectParticlesOutOfObstacles(m, c, w.grid, s.particles, w.contact, &r.obstacles);
+  ProjectParticlesOutOfObstacles(m, c, s.rigid, w.grid, s.particles, w.contact, &r.obstacles);
 }
 
 void GridToParticleUslStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -56,7 +56,7 @@ void RemapMomentumStage(const Model& m, const StepContext& c, State& s, Workspac
   RemapMomentum(m, c, s.particles, w.grid);
   // The re-mapped velocities obey the obstacles too (no reaction logged: the step's impulse
   // was counted in ObstacleContact).
-  if (!m.obstacles.empty()) ApplyObstacleContact(m, c, w.grid, w.contact, nullptr);
+  if (!m.obstacles.empty()) ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, nullptr);
 }
 
 void VelocityGradientStage(const Model& m, const StepContext& c, State& s, Workspace& w,

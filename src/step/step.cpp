@@ -40,6 +40,10 @@ Pipeline MakePipeline(const Model& model) {
     p.push_back({Stage::kVelocityGradient, VelocityGradientStage});            // (2.17)
   }
   if (obstacles) p.push_back({Stage::kObstacleProjection, ObstacleProjectionStage});
+  const bool dynamic = std::any_of(model.obstacles.begin(), model.obstacles.end(), [](const Obstacle& o) {
+    return o.motion.kind == ObstacleMotionKind::kDynamic;
+  });
+  if (dynamic) p.push_back({Stage::kRigidBodies, RigidBodiesStage});             // Bullet
   if (!model.sensors.empty()) p.push_back({Stage::kSensors, SensorsStage});  // all reactions in
   if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
   p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)

@@ -1,9 +1,11 @@
 // Workspace: grid and per-particle scratch, rebuilt every step and never saved (STYLE H.4).
 #pragma once
+#include <memory>
 #include <vector>
 
 #include "contact/contact.h"
 #include "grid/sparse_grid.h"
+#include "rigid/rigid_world.h"
 #include "stabilize/antilocking.h"
 #include "transfer/transfer.h"
 
@@ -17,6 +19,13 @@ struct Workspace {
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
   AntiLockingScratch antilocking;       // node sums of AntiLocking
   ContactScratch contact;               // broad phase and partial sums of the obstacle contact
+  // Bullet world of the dynamic obstacles (built from Model + State on first use; the rigid
+  // state of record is State::rigid), each dynamic body's handle and its Bullet frame at t = 0.
+  std::unique_ptr<RigidWorld> rigid_world;
+  std::vector<int> rigid_handle;     // by ObstacleMotion::body
+  std::vector<Mat3> rigid_frame0;    // R_bullet(0) by ObstacleMotion::body
+  std::vector<Vec3> rigid_offset;    // reference point in Bullet's body frame, by body
+  std::vector<Real> rigid_mass;      // [kg], by body
 };
 
 }  // namespace surge

@@ -323,13 +323,25 @@ TEST(ObstacleParserTest, NameDomainIsReservedAndNamesAreIdentifiers) {
 TEST(ObstacleParserTest, BadMotionSpellings) {
   const std::string head = "name: c\n    shape: {box: {min: [1.5, 0, 0], max: [2, 1, 1]}}\n";
   ExpectError(WithObstacle(3, head + "    motion: fix\n"), 15, "obstacles[0].motion",
-              "unknown motion 'fix' (expected fixed or {prescribed: {...}})");
+              "unknown motion 'fix' (expected fixed, {prescribed: {...}} or {dynamic: {...}})");
   ExpectError(WithObstacle(3, head + "    motion: prescribed\n"), 15, "obstacles[0].motion",
               "a prescribed motion needs its velocities");
   ExpectError(WithObstacle(3, head + "    motion: {fixed: true}\n"), 15, "obstacles[0].motion",
               "write motion: fixed (a plain value)");
-  ExpectError(WithObstacle(3, head + "    motion: {dynamic: {mass: 10}}\n"), 15, "obstacles[0].motion.dynamic",
-              "unknown key 'dynamic' (expected one of: fixed, prescribed)");
+  ExpectError(WithObstacle(3, head + "    motion: {dynamic: {mass: 10, density: 2000}}\n"), 15,
+              "obstacles[0].motion.dynamic", "give exactly one of mass [kg] and density [kg/m^3]");
+  ExpectError(WithObstacle(3, head + "    motion: {dynamic: {}}\n"), 15,
+              "obstacles[0].motion.dynamic", "give exactly one of mass [kg] and density [kg/m^3]");
+  ExpectError(WithObstacle(3, head + "    motion: {dynamic: {mass: 10, restitution: 2}}\n"), 15,
+              "obstacles[0].motion.dynamic.restitution", "must be in [0, 1]");
+  ExpectError(WithObstacle(3, head + "    motion: {dynamic: {mass: 10, spin: 1}}\n"), 15,
+              "obstacles[0].motion.dynamic.spin", "unknown key 'spin'");
+  ExpectError(WithObstacle(2, "name: c\n    shape: {box: {min: [1.5, 0], max: [2, 1]}}\n"
+                              "    motion: {dynamic: {mass: 10}}\n"),
+              15, "obstacles[0].motion.dynamic", "dynamic obstacles are 3-D only");
+  ExpectError(WithObstacle(3, "name: c\n    shape: {plane: {point: [0, 0, 0], normal: [0, 1, 0]}}\n"
+                              "    motion: {dynamic: {mass: 10}}\n"),
+              15, "obstacles[0].motion.dynamic", "a plane is infinite and cannot be dynamic");
   ExpectError(WithObstacle(3, head + "    motion: {prescribed: {velocity: [1, 0, 0], spin: 3}}\n"), 15,
               "obstacles[0].motion.prescribed.spin",
               "unknown key 'spin' (expected one of: velocity, angular_velocity_deg, center)");
@@ -429,13 +441,23 @@ TEST(ObstacleResolvedYamlTest, EveryKindRereadsToTheSameYaml3D) {
       "  - name: shell\n"
       "    shape: {mesh: {file: " + kMeshDir + "open_box.obj, scale: 0.2, translate: [1.5, -0.8, 1.5], "
       "one_sided: true}}\n"
-      "    motion: {prescribed: {velocity: [0, 0.1, 0], angular_velocity_deg: [0, 0, 30], center: [1.6, -0.7, 1.6]}}\n";
+      "    motion: {prescribed: {velocity: [0, 0.1, 0], angular_velocity_deg: [0, 0, 30], center: [1.6, -0.7, 1.6]}}\n"
+      "  - name: boulder\n"
+      "    shape: {sphere: {center: [-0.6, 1.6, 1.6], radius: 0.15}}\n"
+      "    motion: {dynamic: {density: 2600, velocity: [1, 0, 0], angular_velocity_deg: [0, 0, 10], restitution: 0.2}}\n"
+      "    contact: {friction: 0.4, adhesion: 50}\n"
+      "sensors:\n"
+      "  - {name: strip, box: {min: [1.2, 0, 0], max: [1.3, 0.5, 0.5]}}\n";
   const LoadedScene a = LoadSceneFromString(text, "s.yaml");
-  ASSERT_EQ(a.model.obstacles.size(), 8u);
+  ASSERT_EQ(a.model.obstacles.size(), 9u);
+  ASSERT_EQ(a.model.sensors.size(), 1u);
+  ASSERT_EQ(a.state.rigid.size(), 1u);  // the dynamic boulder
+  EXPECT_EQ(a.model.obstacles[8].motion.body, 0);
   EXPECT_EQ(a.state.particles.size(), 512u);  // the obstacles miss the body
   for (const char* key : {"obstacles:", "plane:", "box:", "sphere:", "cylinder:", "polygon:", "mesh:",
                           "one_sided: true", "motion: fixed", "prescribed:", "separable: false",
-                          "reference_point:"}) {
+                          "reference_point:", "dynamic:", "density: 2600", "adhesion: 50",
+                          "sensors:"}) {
     EXPECT_NE(a.resolved_yaml.find(key), std::string::npos) << key << " in\n" << a.resolved_yaml;
   }
   const LoadedScene b = LoadSceneFromString(a.resolved_yaml, "resolved.yaml");
