@@ -221,6 +221,25 @@ ObstaclePose PoseAt(const Obstacle& obstacle, Real t, const std::vector<RigidBod
     pose.angular_velocity = s.angular_velocity;
     return pose;
   }
+  if (!m.table.empty()) {
+    // Piecewise-linear displacement table: c(t) = c0 + d(t), v = d'(t) on the current segment.
+    const auto& T = m.table;
+    if (t <= T.front()[0] || T.size() == 1) {
+      pose.center = m.center + Vec3(T.front()[1], T.front()[2], T.front()[3]);
+    } else if (t >= T.back()[0]) {
+      pose.center = m.center + Vec3(T.back()[1], T.back()[2], T.back()[3]);
+    } else {
+      size_t k = 1;
+      while (T[k][0] < t) ++k;  // T[k-1][0] < t <= T[k][0]
+      const auto& a = T[k - 1];
+      const auto& b = T[k];
+      const Real s = (t - a[0]) / (b[0] - a[0]);
+      const Vec3 da(a[1], a[2], a[3]), db(b[1], b[2], b[3]);
+      pose.center = m.center + da + s * (db - da);
+      pose.velocity = (db - da) / (b[0] - a[0]);
+    }
+    return pose;
+  }
   pose.velocity = m.velocity;
   pose.angular_velocity = m.angular_velocity;
   pose.center = m.center + t * m.velocity;

@@ -56,6 +56,10 @@ struct ObstacleMotion {
   Vec3 velocity = Vec3::Zero();          // v [m/s] (dynamic: initial)
   Vec3 angular_velocity = Vec3::Zero();  // omega [rad/s] (2-D: z component only; dynamic: initial)
   Vec3 center = Vec3::Zero();            // c0: centre of rotation (dynamic: of mass) at t = 0 [m]
+  // Prescribed by a time table instead (when not empty): rows {t, dx, dy, dz}, t increasing, the
+  // displacement of the centre, linearly interpolated (held constant outside the table), no
+  // rotation; velocity = the slope of the current segment.
+  std::vector<std::array<Real, 4>> table;
   // Dynamic only (exactly one of mass and density is > 0).
   int body = -1;          // index into State::rigid
   Real mass = 0;          // [kg]

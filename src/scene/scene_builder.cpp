@@ -94,6 +94,20 @@ Obstacle BuildObstacle(const SceneSpec& spec, size_t index) {
                           Eigen::AngleAxis<Real>(s.rotate_deg.x() * kDeg, Vec3::UnitX()))
                              .toRotationMatrix();
           for (Vec3& v : mesh.vertices) v = R * (s.scale * v) + s.translate;
+          if (s.faces_by_normal) {
+            // Faces by direction: each triangle joins the face of its normal's dominant axis and
+            // sign, named like a box's faces (a pier's upstream nose is then mostly x-).
+            mesh.part_names = {"x-", "x+", "y-", "y+", "z-", "z+"};
+            mesh.part.assign(mesh.triangles.size(), 0);
+            for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+              const auto& t = mesh.triangles[k];
+              const Vec3 n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                                 .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+              int axis = 0;
+              n.cwiseAbs().maxCoeff(&axis);
+              mesh.part[k] = 2 * axis + (n[axis] > 0 ? 1 : 0);
+            }
+          }
           MeshShape shape;
           shape.file = s.file;
           try {
@@ -119,6 +133,7 @@ Obstacle BuildObstacle(const SceneSpec& spec, size_t index) {
   o.motion.velocity = os.velocity;
   o.motion.angular_velocity = os.angular_velocity_deg * (std::numbers::pi / 180.0);
   o.motion.center = os.center ? *os.center : o.reference_point;
+  o.motion.table = os.table;
   if (os.motion == ObstacleMotionKind::kDynamic) {
     // The state of a dynamic body is that of its reference point (obstacle.h RigidBodyState).
     o.motion.center = o.reference_point;

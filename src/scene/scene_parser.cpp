@@ -802,7 +802,7 @@ ObstacleShapeSpec Parser::ParseObstacleShape(const YAML::Node& n, const std::str
   }
   if (kind == "mesh") {
     if (dim_ == 2) Fail(n.begin()->first, p, "mesh obstacles are 3-D only (in 2-D use polygon)");
-    ExpectMap(s, p, {"file", "scale", "rotate_deg", "translate", "one_sided"});
+    ExpectMap(s, p, {"file", "scale", "rotate_deg", "translate", "one_sided", "faces"});
     ObstacleMeshSpec mesh;
     const YAML::Node file = Need(s, p, "file");
     const std::filesystem::path f = String(file, Child(p, "file"));
@@ -814,6 +814,13 @@ ObstacleShapeSpec Parser::ParseObstacleShape(const YAML::Node& n, const std::str
     if (s["rotate_deg"]) mesh.rotate_deg = Vector(s["rotate_deg"], Child(p, "rotate_deg"), "deg");
     if (s["translate"]) mesh.translate = Vector(s["translate"], Child(p, "translate"), "m");
     if (s["one_sided"]) mesh.one_sided = Bool(s["one_sided"], Child(p, "one_sided"));
+    if (s["faces"]) {
+      const YAML::Node f = s["faces"];
+      if (!f.IsScalar() || (f.Scalar() != "parts" && f.Scalar() != "normal")) {
+        Fail(f, Child(p, "faces"), "expected parts or normal, got " + Describe(f));
+      }
+      mesh.faces_by_normal = f.Scalar() == "normal";
+    }
     return mesh;
   }
   // box, sphere, cylinder, polygon: the region shapes.
@@ -883,8 +890,32 @@ ObstacleSpec Parser::ParseObstacle(const YAML::Node& n, const std::string& path)
       } else {
       const YAML::Node pr = Need(m, mp, "prescribed");
       const std::string pp = Child(mp, "prescribed");
-      ExpectMap(pr, pp, {"velocity", "angular_velocity_deg", "center"});
+      ExpectMap(pr, pp, {"velocity", "angular_velocity_deg", "center", "table"});
       o.motion = ObstacleMotionKind::kPrescribed;
+      if (pr["table"]) {
+        const YAML::Node tb = pr["table"];
+        const std::string tp = Child(pp, "table");
+        if (pr["velocity"] || pr["angular_velocity_deg"]) {
+          Fail(tb, tp, "give either a table or velocity/angular_velocity_deg, not both");
+        }
+        const size_t cols = size_t(dim_) + 1;
+        const std::string row = dim_ == 2 ? "[t, dx, dy]" : "[t, dx, dy, dz]";
+        if (!tb.IsSequence() || tb.size() == 0) {
+          Fail(tb, tp, "expected a list of " + row + " rows [s, m], got " + Describe(tb));
+        }
+        for (size_t i = 0; i < tb.size(); ++i) {
+          const YAML::Node r = tb[i];
+          if (!r.IsSequence() || r.size() != cols) {
+            Fail(r, Index(tp, i), "expected a row " + row + " [s, m], got " + Describe(r));
+          }
+          std::array<Real, 4> v{};
+          for (size_t c = 0; c < cols; ++c) v[c] = Number(r[c], Index(Index(tp, i), c), c ? "m" : "s");
+          if (!o.table.empty() && !(v[0] > o.table.back()[0])) {
+            Fail(r[0], Index(Index(tp, i), 0), "times must increase row by row");
+          }
+          o.table.push_back(v);
+        }
+      }
       if (pr["velocity"]) o.velocity = Vector(pr["velocity"], Child(pp, "velocity"), "m/s");
       if (pr["angular_velocity_deg"]) {
         const YAML::Node w = pr["angular_velocity_deg"];
@@ -1210,6 +1241,7 @@ void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
     e << YAML::Key << "translate" << YAML::Value;
     EmitVector(e, mesh->translate, dim);
     e << YAML::Key << "one_sided" << YAML::Value << mesh->one_sided;
+    e << YAML::Key << "faces" << YAML::Value << (mesh->faces_by_normal ? "normal" : "parts");
     e << YAML::EndMap << YAML::EndMap;
   } else {
     std::visit([&](const auto& r) {
@@ -1234,13 +1266,23 @@ void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
     e << YAML::EndMap << YAML::EndMap;
   } else {
     e << YAML::BeginMap << YAML::Key << "prescribed" << YAML::Value << YAML::BeginMap;
-    e << YAML::Key << "velocity" << YAML::Value;
-    EmitVector(e, o.velocity, dim);
-    e << YAML::Key << "angular_velocity_deg" << YAML::Value;
-    if (dim == 2) {
-      e << Num(o.angular_velocity_deg.z());
+    if (!o.table.empty()) {
+      e << YAML::Key << "table" << YAML::Value << YAML::BeginSeq;
+      for (const auto& r : o.table) {
+        e << YAML::Flow << YAML::BeginSeq;
+        for (int c = 0; c <= dim; ++c) e << Num(r[size_t(c)]);
+        e << YAML::EndSeq;
+      }
+      e << YAML::EndSeq;
     } else {
-      EmitVector(e, o.angular_velocity_deg, dim);
+      e << YAML::Key << "velocity" << YAML::Value;
+      EmitVector(e, o.velocity, dim);
+      e << YAML::Key << "angular_velocity_deg" << YAML::Value;
+      if (dim == 2) {
+        e << Num(o.angular_velocity_deg.z());
+      } else {
+        EmitVector(e, o.angular_velocity_deg, dim);
+      }
     }
     if (o.center) {
       e << YAML::Key << "center" << YAML::Value;

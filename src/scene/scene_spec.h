@@ -186,6 +186,8 @@ struct ObstacleMeshSpec {
   Vec3 rotate_deg = Vec3::Zero();   // rotations about x, then y, then z [deg]
   Vec3 translate = Vec3::Zero();    // [m], applied last
   bool one_sided = false;           // an open mesh: its triangle normals point to the outside
+  bool faces_by_normal = false;     // faces: normal: triangles grouped as x-, x+, y-, y+, z-, z+
+                                    // by their normal's dominant axis (default: mesh parts)
   SourceLoc file_loc;
 };
 using ObstacleShapeSpec =
@@ -201,6 +203,7 @@ struct ObstacleSpec {
   Real density = 0;                          // dynamic: [kg/m^3] (or mass)
   Real restitution = 0;                      // dynamic: Bullet collisions [-]
   std::optional<Vec3> center;                // centre of rotation; default: reference point
+  std::vector<std::array<Real, 4>> table;    // prescribed by a table: {t, dx, dy, dz} rows
   ObstacleContact contact;
   std::optional<Vec3> reference_point;       // torque reference; default: centre of the bounds
   SourceLoc loc;

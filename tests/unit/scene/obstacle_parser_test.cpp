@@ -551,3 +551,59 @@ TEST(ShippedScenesTest, EverySceneLoadsAndIsListed) {
 
 }  // namespace
 }  // namespace surge
+
+namespace surge {
+namespace {
+
+TEST(ObstacleMotionTableTest, TableIsInterpolatedAndItsSlopeIsTheVelocity) {
+  const LoadedScene s = LoadSceneFromString(
+      WithObstacle(3, "name: gate\n"
+                      "    shape: {box: {min: [1.25, 0, 0], max: [1.5, 1, 1]}}\n"
+                      "    motion: {prescribed: {table: [[0, 0, 0, 0], [0.5, 0.25, 0, 0], [1.5, 0.25, 0.5, 0]]}}\n"),
+      "s.yaml");
+  const Obstacle& o = OnlyObstacle(s);
+  ASSERT_EQ(o.motion.table.size(), 3u);
+  const Vec3 c0 = o.motion.center;
+  ObstaclePose p = PoseAt(o, 0.25);
+  EXPECT_NEAR((p.center - c0 - Vec3(0.125, 0, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((p.velocity - Vec3(0.5, 0, 0)).norm(), 0, 1e-15);
+  p = PoseAt(o, 1.0);
+  EXPECT_NEAR((p.center - c0 - Vec3(0.25, 0.25, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((p.velocity - Vec3(0, 0.5, 0)).norm(), 0, 1e-15);
+  p = PoseAt(o, 3.0);  // held after the table
+  EXPECT_NEAR((p.center - c0 - Vec3(0.25, 0.5, 0)).norm(), 0, 1e-15);
+  EXPECT_EQ(p.velocity, Vec3::Zero());
+  // The resolved YAML keeps the table and reads back to itself.
+  EXPECT_NE(s.resolved_yaml.find("table:"), std::string::npos) << s.resolved_yaml;
+  const LoadedScene again = LoadSceneFromString(s.resolved_yaml, "resolved.yaml");
+  EXPECT_EQ(again.resolved_yaml, s.resolved_yaml);
+}
+
+TEST(ObstacleMotionTableTest, BadTables) {
+  const std::string head = "name: c\n    shape: {box: {min: [1.5, 0, 0], max: [2, 1, 1]}}\n";
+  ExpectError(WithObstacle(3, head + "    motion: {prescribed: {table: [[0, 0, 0, 0], [0, 1, 0, 0]]}}\n"),
+              15, "obstacles[0].motion.prescribed.table[1][0]", "times must increase");
+  ExpectError(WithObstacle(3, head + "    motion: {prescribed: {table: [[0, 0, 0]]}}\n"), 15,
+              "obstacles[0].motion.prescribed.table[0]", "expected a row [t, dx, dy, dz]");
+  ExpectError(WithObstacle(3, head + "    motion: {prescribed: {table: [[0, 0, 0, 0]], velocity: [1, 0, 0]}}\n"),
+              15, "obstacles[0].motion.prescribed.table", "either a table or velocity");
+}
+
+TEST(ObstacleMeshFacesTest, FacesByNormalGroupTrianglesByDirection) {
+  const LoadedScene s = LoadSceneFromString(
+      WithObstacle(3, "{name: crate, shape: {mesh: {file: " + kMeshDir +
+                          "unit_cube.stl, scale: 0.25, translate: [1.25, 0, 0], faces: normal}}}\n"),
+      "s.yaml");
+  const Obstacle& o = OnlyObstacle(s);
+  EXPECT_EQ(o.faces, (std::vector<std::string>{"x-", "x+", "y-", "y+", "z-", "z+"}));
+  // A point just outside the +x side of the cube touches face x+.
+  const Vec3 lo = o.bounds_min, hi = o.bounds_max;
+  const Vec3 mid = 0.5 * (lo + hi);
+  const SurfaceQuery q = QueryObstacle(o, PoseAt(o, 0), Vec3(hi.x() - 1e-3, mid.y(), mid.z()), 3, 0, 1.0);
+  ASSERT_EQ(q.count, 1);
+  EXPECT_EQ(o.faces[size_t(q.face[0])], "x+");
+  EXPECT_NE(s.resolved_yaml.find("faces: normal"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace surge
