@@ -1,5 +1,6 @@
-// The only includer of HDF5 (STYLE H.10): run metadata, particle snapshots, energy and force
-// series and stage timings in <out>/<name>.h5, and the force series as CSV. Layout and units:
+// The only includer of HDF5 (STYLE H.10): run metadata, particle snapshots, energy, force and
+// rigid-body series and stage timings in <out>/<name>.h5, and the force and rigid-body series
+// as CSV. Layout and units:
 // docs/results-format.md. The XDMF sidecar is written by xdmf.cpp from the snapshot list kept here.
 #include <hdf5.h>
 
@@ -288,7 +289,41 @@ void AppendNumber(std::string& line, int64_t v) {
   line.append(buf, end);
 }
 
+// --- Rigid-body series (/rigid, rigid_<name>.csv) ---
+
+// Pending rigid rows are flushed like the force rows (kForceFlushRows, on their own count).
+constexpr size_t kRigidFlushRows = 1000;
+
+// One body's pending rows, column by column; cleared (capacity kept) after each flush.
+struct RigidColumns {
+  std::vector<double> time, position, rotation, velocity, angular_velocity;  // x 1, 3, 4, 3, 3
+  std::vector<int64_t> step;
+
+  void Push(Real t, int64_t s, const RigidBodyState& b) {
+    time.push_back(t);
+    step.push_back(s);
+    const std::array<Real, 4> q = RotationQuaternion(b.rotation);
+    rotation.insert(rotation.end(), q.begin(), q.end());
+    for (int d = 0; d < 3; ++d) {
+      position.push_back(b.position[d]);
+      velocity.push_back(b.velocity[d]);
+      angular_velocity.push_back(b.angular_velocity[d]);
+    }
+  }
+  void Clear() {
+    for (auto* v : {&time, &position, &rotation, &velocity, &angular_velocity}) v->clear();
+    step.clear();
+  }
+};
+
 }  // namespace
+
+std::array<Real, 4> RotationQuaternion(const Mat3& R) {
+  Eigen::Quaternion<Real> q(R);  // Shoemake 1987, as Eigen implements it
+  q.normalize();
+  const Real sign = q.w() < 0 ? -1 : 1;
+  return {sign * q.w(), sign * q.x(), sign * q.y(), sign * q.z()};
+}
 
 void StrainInvariants(const Mat3& F, Real& volumetric, Real& equivalent) {
   const Real J = F.determinant();
@@ -350,6 +385,14 @@ struct ResultsWriter::Impl {
   std::vector<std::string> csv_paths;
   std::vector<FILE*> csv;
   std::string line;  // CSV scratch
+  // Rigid-body series: pending rows per body, rows already in the .h5, one CSV per body.
+  bool rigid_begun = false;
+  std::vector<std::string> rigid_names;
+  std::vector<RigidColumns> rigid_pending;
+  size_t rigid_pending_rows = 0;
+  hsize_t rigid_rows = 0;
+  std::vector<std::string> rigid_csv_paths;
+  std::vector<FILE*> rigid_csv;
 
   Impl() { energy_sets.fill(-1); }
   ~Impl() {
@@ -433,9 +476,64 @@ struct ResultsWriter::Impl {
     force_pending_rows = 0;
   }
 
+  // Appends the pending rigid rows to /rigid/<name>/... (the CSV rows stay pending for
+  // WriteRigidCsv, which follows the next Commit or file close).
+  void WriteRigidRows() {
+    const hsize_t add = rigid_pending_rows;
+    if (add == 0) return;
+    for (size_t b = 0; b < rigid_names.size(); ++b) {
+      const RigidColumns& c = rigid_pending[b];
+      const std::string group = "/rigid/" + rigid_names[b];
+      Handle g(H5Gopen2(file, group.c_str(), H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "open group " + group, h5);
+      const auto doubles = [&](const char* name, const std::vector<double>& v, size_t cols) {
+        AppendSeries(g.get(), name, H5T_NATIVE_DOUBLE, v.data(), rigid_rows, add, cols, h5);
+      };
+      doubles("time", c.time, 0);
+      AppendSeries(g.get(), "step", H5T_NATIVE_INT64, c.step.data(), rigid_rows, add, 0, h5);
+      doubles("position", c.position, 3);
+      doubles("rotation", c.rotation, 4);
+      doubles("velocity", c.velocity, 3);
+      doubles("angular_velocity", c.angular_velocity, 3);
+    }
+    rigid_rows += add;
+  }
+
+  // Appends the pending rigid rows to the CSV files, flushes them to the OS and clears them.
+  void WriteRigidCsv() {
+    if (rigid_pending_rows == 0) return;
+    for (size_t b = 0; b < rigid_csv.size(); ++b) {
+      const RigidColumns& c = rigid_pending[b];
+      for (size_t r = 0; r < rigid_pending_rows; ++r) {
+        line.clear();
+        const auto number = [&](auto v) {
+          AppendNumber(line, v);
+          line += ',';
+        };
+        number(c.time[r]);
+        number(c.step[r]);
+        for (int d = 0; d < 3; ++d) number(c.position[3 * r + d]);
+        for (int d = 0; d < 4; ++d) number(c.rotation[4 * r + d]);
+        for (int d = 0; d < 3; ++d) number(c.velocity[3 * r + d]);
+        for (int d = 0; d < 3; ++d) number(c.angular_velocity[3 * r + d]);
+        line.back() = '\n';
+        if (std::fputs(line.c_str(), rigid_csv[b]) == EOF)
+          throw IoError("cannot write '" + rigid_csv_paths[b] + "'");
+      }
+      if (std::fflush(rigid_csv[b]) != 0)
+        throw IoError("cannot write '" + rigid_csv_paths[b] + "'");
+    }
+    for (RigidColumns& c : rigid_pending) c.Clear();
+    rigid_pending_rows = 0;
+  }
+
   // Never throws.
   void CloseCsv() {
     for (FILE*& f : csv) {
+      if (f) std::fclose(f);
+      f = nullptr;
+    }
+    for (FILE*& f : rigid_csv) {
       if (f) std::fclose(f);
       f = nullptr;
     }
@@ -571,12 +669,17 @@ ResultsWriter::~ResultsWriter() {
   try {
     impl_->WriteEnergyRows();
     impl_->WriteForceRows();
+    impl_->WriteRigidRows();
   } catch (...) {
     // A destructor must not throw; the rows written so far stay in the file.
   }
   impl_->CloseHandles();
   try {
     impl_->WriteForceCsv();
+  } catch (...) {
+  }
+  try {
+    impl_->WriteRigidCsv();
   } catch (...) {
   }
   impl_->CloseCsv();
@@ -635,8 +738,10 @@ void ResultsWriter::WriteSnapshot(const State& state) {
   }
   I.WriteEnergyRows();
   I.WriteForceRows();
+  I.WriteRigidRows();
   I.Commit();
   I.WriteForceCsv();
+  I.WriteRigidCsv();
   // The .xmf lists a snapshot only once it is on disk.
   I.written.push_back(XdmfSnapshot{std::string("/snapshots/") + name, state.time, n});
   WriteXdmf(I.xmf, fs::path(I.h5).filename().string(), I.written);
@@ -749,12 +854,76 @@ void ResultsWriter::AppendForces(Real time, int64_t step, Real dt, const Contact
   }
 }
 
+void ResultsWriter::BeginRigid(const std::vector<std::string>& names) {
+  Impl& I = *impl_;
+  if (I.closed) throw IoError("BeginRigid after Close on '" + I.h5 + "'");
+  if (I.rigid_begun) throw IoError("BeginRigid called twice on '" + I.h5 + "'");
+  std::set<std::string> seen;
+  for (const std::string& name : names) {
+    if (!IsSafeName(name) || !seen.insert(name).second)
+      throw IoError("rigid body name '" + name + "' is empty, repeated or not [A-Za-z0-9_-]+");
+  }
+  I.rigid_begun = true;
+  I.rigid_names = names;
+  I.rigid_pending.assign(names.size(), RigidColumns{});
+  {  // groups are closed before Commit closes the file
+    Handle rigid(H5Gcreate2(I.file, "rigid", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    Require(rigid.ok(), "create group /rigid", I.h5);
+    WriteStringAttr(rigid.get(), "bodies", Join(names), I.h5);
+    for (const std::string& name : names) {
+      Handle g(H5Gcreate2(rigid.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+               H5Gclose);
+      Require(g.ok(), "create group /rigid/" + name, I.h5);
+      CreateSeries(g.get(), "time", H5T_IEEE_F64LE, 0, "s", I.h5);
+      CreateSeries(g.get(), "step", H5T_STD_I64LE, 0, "-", I.h5);
+      CreateSeries(g.get(), "position", H5T_IEEE_F64LE, 3, "m", I.h5);
+      CreateSeries(g.get(), "rotation", H5T_IEEE_F64LE, 4, "-", I.h5);
+      CreateSeries(g.get(), "velocity", H5T_IEEE_F64LE, 3, "m/s", I.h5);
+      CreateSeries(g.get(), "angular_velocity", H5T_IEEE_F64LE, 3, "rad/s", I.h5);
+    }
+  }
+  I.Commit();
+
+  for (const std::string& name : names) {
+    const std::string path = rigid_csv_path(name);
+    FILE* f = std::fopen(path.c_str(), "w");
+    if (!f) throw IoError("cannot create '" + path + "': " + std::strerror(errno));
+    I.rigid_csv.push_back(f);
+    I.rigid_csv_paths.push_back(path);
+    const char* header =
+        "time_s,step,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,wx_rad_s,wy_rad_s,wz_rad_s\n";
+    if (std::fputs(header, f) == EOF || std::fflush(f) != 0)
+      throw IoError("cannot write '" + path + "'");
+  }
+}
+
+void ResultsWriter::AppendRigid(Real time, int64_t step,
+                                const std::vector<RigidBodyState>& bodies) {
+  Impl& I = *impl_;
+  if (I.closed) throw IoError("AppendRigid after Close on '" + I.h5 + "'");
+  if (!I.rigid_begun) {
+    if (bodies.empty()) return;  // nothing to log, BeginRigid may be skipped
+    throw IoError("AppendRigid before BeginRigid on '" + I.h5 + "'");
+  }
+  if (bodies.size() != I.rigid_names.size())
+    throw std::logic_error("AppendRigid: " + std::to_string(bodies.size()) + " bodies, " +
+                           std::to_string(I.rigid_names.size()) + " names");
+  for (size_t b = 0; b < bodies.size(); ++b) I.rigid_pending[b].Push(time, step, bodies[b]);
+  ++I.rigid_pending_rows;
+  if (I.rigid_pending_rows >= kRigidFlushRows) {
+    I.WriteRigidRows();
+    I.Commit();
+    I.WriteRigidCsv();
+  }
+}
+
 void ResultsWriter::Close(const StageSeconds& stage_seconds, int64_t steps, double wall_seconds,
                           const std::string& exit_status) {
   Impl& I = *impl_;
   if (I.closed) return;
   I.WriteEnergyRows();
   I.WriteForceRows();
+  I.WriteRigidRows();
   if (I.forces_begun) {  // the peak/impulse summary as attributes of the force groups
     const std::vector<ForceChannel>& channels = I.summary.channels();
     for (size_t s = 0; s < channels.size(); ++s) {
@@ -785,6 +954,7 @@ void ResultsWriter::Close(const StageSeconds& stage_seconds, int64_t steps, doub
   I.closed = true;
   I.CloseHandles();
   I.WriteForceCsv();
+  I.WriteRigidCsv();
   I.CloseCsv();
 }
 
@@ -793,6 +963,9 @@ std::string ResultsWriter::xmf_path() const { return impl_->xmf; }
 int ResultsWriter::snapshot_count() const { return int(impl_->written.size()); }
 std::string ResultsWriter::forces_csv_path(const std::string& structure) const {
   return (fs::path(impl_->out_dir) / ("forces_" + structure + ".csv")).string();
+}
+std::string ResultsWriter::rigid_csv_path(const std::string& body) const {
+  return (fs::path(impl_->out_dir) / ("rigid_" + body + ".csv")).string();
 }
 const ForceSummary& ResultsWriter::force_summary() const { return impl_->summary; }
 

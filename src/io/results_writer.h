@@ -1,8 +1,10 @@
 // Results of one run (DESIGN §7): <out>/<name>.h5 with run metadata, particle snapshots, the
-// energy series and the per-step force series (/forces, and <out>/forces_<structure>.csv), plus
+// energy series, the per-step force series (/forces, and <out>/forces_<structure>.csv) and the
+// per-step motion of the dynamic rigid bodies (/rigid, and <out>/rigid_<body>.csv), plus
 // <out>/<name>.xmf so ParaView opens the HDF5 directly. HDF5 stays in hdf5_writer.cpp (pimpl).
 // Layout: docs/results-format.md.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -60,6 +62,18 @@ class ResultsWriter {
   // peak/impulse summary (ForceSummary) is updated at once and written on Close.
   // Pre: BeginForces was called; report has the channels' shape (else std::logic_error).
   void AppendForces(Real time, int64_t step, Real dt, const ContactReport& report);
+  // Starts the rigid-body series: creates /rigid/<name>/... in the .h5 and truncates and heads
+  // <out>/rigid_<name>.csv for every dynamic body, names in State::rigid order
+  // (ObstacleMotion::body). Call once, before the first AppendRigid; may be skipped when there
+  // are no dynamic bodies. Throws IoError for a second call, a name outside [A-Za-z0-9_-]+, a
+  // repeated name, and when a CSV file cannot be created.
+  void BeginRigid(const std::vector<std::string>& names);
+  // One row per body: its state at `time` [s] after `step` completed steps (state.time,
+  // state.step and state.rigid after Step); the rotation is stored as a unit quaternion
+  // (RotationQuaternion). Buffered and flushed like the force rows (at each WriteSnapshot,
+  // whenever 1000 rows are pending, and on Close).
+  // Pre: BeginRigid was called with bodies.size() names (else std::logic_error).
+  void AppendRigid(Real time, int64_t step, const std::vector<RigidBodyState>& bodies);
   // Writes the pending rows, the force summary, stage timings and the exit status, then closes
   // the files.
   void Close(const StageSeconds& stage_seconds, int64_t steps, double wall_seconds,
@@ -70,6 +84,8 @@ class ResultsWriter {
   int snapshot_count() const;
   // <out>/forces_<structure>.csv (whether or not it exists).
   std::string forces_csv_path(const std::string& structure) const;
+  // <out>/rigid_<body>.csv (whether or not it exists).
+  std::string rigid_csv_path(const std::string& body) const;
   // Peaks and impulses of every row appended so far (empty before BeginForces).
   const ForceSummary& force_summary() const;
 
@@ -81,6 +97,14 @@ class ResultsWriter {
 // Strain invariants of a deformation gradient (Hencky strain eps = 1/2 ln(F F^T)):
 // volumetric ln J and equivalent deviatoric strain sqrt(2/3 e:e), e = dev(eps).
 void StrainInvariants(const Mat3& F, Real& volumetric, Real& equivalent);
+
+// The unit quaternion (w, x, y, z) of a rotation matrix R (R = the rotation of q, Hamilton
+// convention, as Eigen::Quaterniond::toRotationMatrix), with w >= 0 (q and -q are the same
+// rotation; this picks one so that every row can be read on its own, at the cost of a sign jump
+// where a body turns through 180 degrees). Eigen's conversion (K. Shoemake, "Quaternion Calculus
+// and Fast Animation", SIGGRAPH 1987 course notes: from the trace, or from the largest diagonal
+// element when the trace is <= 0), then normalised.
+std::array<Real, 4> RotationQuaternion(const Mat3& R);
 
 // HDF5 library version, e.g. "1.10.8" (for `surge info`).
 std::string Hdf5Version();

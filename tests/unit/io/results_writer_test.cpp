@@ -1,6 +1,7 @@
 // ResultsWriter: layout, values, verbatim scene text, energy rows, timing, XDMF, crash safety
 // (a child process killed after or during a snapshot), errors; force series (HDF5 and CSV, flush
-// cadence, kill, summary attributes); StrainInvariants.
+// cadence, kill, summary attributes); rigid-body series (HDF5 and CSV, flush cadence, kill,
+// misuse) and RotationQuaternion; StrainInvariants.
 #include "io/results_writer.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -811,6 +813,289 @@ TEST_F(ResultsWriterTest, ForceSeriesMisuseThrows) {
   w.Close(StageSeconds{}, 1, 0, "completed");
   EXPECT_THROW(w.AppendForces(0, 1, 1, rows[0].report), IoError);
   ExpectForcesInCsv(dir_ / "forces_domain.csv", channels[0], 0, rows, 1);
+}
+
+// --- Rigid-body series ---
+
+const std::vector<std::string> kBodies = {"boulder", "log-2"};
+
+struct RigidRow {
+  Real time = 0;
+  int64_t step = 0;
+  std::vector<RigidBodyState> bodies;
+};
+
+// Row r: positions and velocities as the synthetic force values (full mantissas, 1e-100..1e100),
+// rotations about a turning axis by angles that sweep 0..2 pi (w of Eigen's quaternion takes
+// both signs), and the identity in row 0.
+std::vector<RigidRow> RigidRows(size_t bodies, size_t n) {
+  std::vector<RigidRow> rows(n);
+  for (size_t r = 0; r < n; ++r) {
+    RigidRow& row = rows[r];
+    row.time = 1e-4 * double(r + 1) * (1 + 0.01 * std::sin(double(r)));
+    row.step = int64_t(r) + 1 + 10000000000;
+    for (size_t b = 0; b < bodies; ++b) {
+      RigidBodyState s;
+      s.position = Vec3(Synthetic(r, b, 0), Synthetic(r, b, 1), Synthetic(r, b, 2));
+      s.velocity = Vec3(Synthetic(r, b, 3), Synthetic(r, b, 4), Synthetic(r, b, 5));
+      s.angular_velocity = Vec3(Synthetic(r, b, 6), Synthetic(r, b, 7), Synthetic(r, b, 8));
+      const Vec3 axis = Vec3(std::sin(double(r)), std::cos(double(r)), 0.3 + double(b));
+      const Real angle = std::fmod(0.37 * double(r) + double(b), 2 * std::numbers::pi);
+      s.rotation = r == 0 ? Mat3(Mat3::Identity())
+                          : Mat3(Eigen::AngleAxis<Real>(angle, axis.normalized()));
+      row.bodies.push_back(s);
+    }
+  }
+  return rows;
+}
+
+void AppendRigidRows(ResultsWriter& w, const std::vector<RigidRow>& rows, size_t begin,
+                     size_t end) {
+  for (size_t r = begin; r < end; ++r) w.AppendRigid(rows[r].time, rows[r].step, rows[r].bodies);
+}
+
+// Every value of rows[0, n) is in /rigid of `f` exactly (the rotation as RotationQuaternion).
+void ExpectRigidInHdf5(hid_t f, const std::vector<std::string>& names,
+                       const std::vector<RigidRow>& rows, size_t n) {
+  for (size_t b = 0; b < names.size(); ++b) {
+    const std::string g = "/rigid/" + names[b] + "/";
+    SCOPED_TRACE(g);
+    EXPECT_EQ(Dims(f, g + "time"), (std::vector<hsize_t>{n}));
+    EXPECT_EQ(Dims(f, g + "step"), (std::vector<hsize_t>{n}));
+    EXPECT_EQ(Dims(f, g + "position"), (std::vector<hsize_t>{n, 3}));
+    EXPECT_EQ(Dims(f, g + "rotation"), (std::vector<hsize_t>{n, 4}));
+    EXPECT_EQ(Dims(f, g + "velocity"), (std::vector<hsize_t>{n, 3}));
+    EXPECT_EQ(Dims(f, g + "angular_velocity"), (std::vector<hsize_t>{n, 3}));
+    const auto time = ReadDoubles(f, g + "time");
+    const auto step = Read<int64_t>(f, g + "step", H5T_NATIVE_INT64);
+    const auto position = ReadDoubles(f, g + "position");
+    const auto rotation = ReadDoubles(f, g + "rotation");
+    const auto velocity = ReadDoubles(f, g + "velocity");
+    const auto omega = ReadDoubles(f, g + "angular_velocity");
+    ASSERT_EQ(time.size(), n);
+    ASSERT_EQ(step.size(), n);
+    ASSERT_EQ(position.size(), 3 * n);
+    ASSERT_EQ(rotation.size(), 4 * n);
+    ASSERT_EQ(velocity.size(), 3 * n);
+    ASSERT_EQ(omega.size(), 3 * n);
+    for (size_t r = 0; r < n; ++r) {
+      const RigidBodyState& s = rows[r].bodies[b];
+      ASSERT_EQ(time[r], rows[r].time) << r;
+      ASSERT_EQ(step[r], rows[r].step) << r;
+      for (int d = 0; d < 3; ++d) {
+        ASSERT_EQ(position[3 * r + d], s.position[d]) << r;
+        ASSERT_EQ(velocity[3 * r + d], s.velocity[d]) << r;
+        ASSERT_EQ(omega[3 * r + d], s.angular_velocity[d]) << r;
+      }
+      const std::array<Real, 4> q = RotationQuaternion(s.rotation);
+      for (int d = 0; d < 4; ++d) ASSERT_EQ(rotation[4 * r + d], q[d]) << r;
+    }
+  }
+}
+
+// The CSV of body b holds the header and exactly rows[0, n), every value round-tripped.
+void ExpectRigidInCsv(const fs::path& csv, size_t b, const std::vector<RigidRow>& rows,
+                      size_t n) {
+  SCOPED_TRACE(csv.string());
+  const std::vector<std::string> lines = ReadLines(csv);
+  ASSERT_EQ(lines.size(), n + 1);
+  EXPECT_EQ(lines[0],
+            "time_s,step,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,wx_rad_s,wy_rad_s,"
+            "wz_rad_s");
+  for (size_t r = 0; r < n; ++r) {
+    const std::vector<std::string> field = Split(lines[r + 1]);
+    ASSERT_EQ(field.size(), 15u) << r;
+    const auto real = [&](size_t i) { return std::strtod(field[i].c_str(), nullptr); };
+    const RigidBodyState& s = rows[r].bodies[b];
+    ASSERT_EQ(real(0), rows[r].time) << r;
+    ASSERT_EQ(int64_t(std::strtoll(field[1].c_str(), nullptr, 10)), rows[r].step) << r;
+    const std::array<Real, 4> q = RotationQuaternion(s.rotation);
+    for (int d = 0; d < 3; ++d) {
+      ASSERT_EQ(real(2 + d), s.position[d]) << r;
+      ASSERT_EQ(real(9 + d), s.velocity[d]) << r;
+      ASSERT_EQ(real(12 + d), s.angular_velocity[d]) << r;
+    }
+    for (int d = 0; d < 4; ++d) ASSERT_EQ(real(5 + d), q[d]) << r;
+  }
+}
+
+TEST_F(ResultsWriterTest, RigidSeriesReadBackExactlyFromHdf5AndCsv) {
+  const size_t n = 300;
+  const auto rows = RigidRows(kBodies.size(), n);
+  fs::path h5;
+  {
+    ResultsWriter w(dir_.string(), "rigid", RunMetadata{}, TinyModel());
+    w.BeginRigid(kBodies);
+    EXPECT_EQ(ReadLines(w.rigid_csv_path("boulder")).size(), 1u) << "the header is on disk";
+    AppendRigidRows(w, rows, 0, 140);
+    EXPECT_EQ(ReadLines(w.rigid_csv_path("log-2")).size(), 1u) << "rows are buffered";
+    w.WriteSnapshot(TinyState(2));
+    EXPECT_EQ(ReadLines(w.rigid_csv_path("log-2")).size(), 141u) << "a snapshot flushes them";
+    AppendRigidRows(w, rows, 140, n);
+    EXPECT_EQ(w.rigid_csv_path("log-2"), (dir_ / "rigid_log-2.csv").string());
+    w.Close(StageSeconds{}, int64_t(n), 0, "completed");
+    h5 = w.h5_path();
+  }
+  hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  ExpectRigidInHdf5(f, kBodies, rows, n);
+  hid_t rigid = H5Gopen2(f, "/rigid", H5P_DEFAULT);
+  ASSERT_GE(rigid, 0);
+  EXPECT_EQ(ReadStringAttr(rigid, "bodies"), "boulder,log-2");
+  H5Gclose(rigid);
+  const std::pair<const char*, const char*> units[] = {{"time", "s"},          {"step", "-"},
+                                                       {"position", "m"},      {"rotation", "-"},
+                                                       {"velocity", "m/s"},
+                                                       {"angular_velocity", "rad/s"}};
+  for (const auto& [name, unit] : units) {
+    hid_t ds = H5Dopen2(f, (std::string("/rigid/log-2/") + name).c_str(), H5P_DEFAULT);
+    ASSERT_GE(ds, 0) << name;
+    EXPECT_EQ(ReadStringAttr(ds, "units"), unit) << name;
+    H5Dclose(ds);
+  }
+  // The stored quaternions are unit, w >= 0, and give back R.
+  const auto q = ReadDoubles(f, "/rigid/boulder/rotation");
+  ASSERT_EQ(q.size(), 4 * n);
+  EXPECT_EQ(q[0], 1.0);  // row 0: identity
+  for (size_t r = 0; r < n; ++r) {
+    const Eigen::Quaternion<Real> quat(q[4 * r], q[4 * r + 1], q[4 * r + 2], q[4 * r + 3]);
+    ASSERT_GE(quat.w(), 0.0) << r;
+    ASSERT_NEAR(quat.norm(), 1.0, 4 * kEps) << r;
+    ASSERT_LT((quat.toRotationMatrix() - rows[r].bodies[0].rotation).cwiseAbs().maxCoeff(),
+              8 * kEps)
+        << r;
+  }
+  H5Fclose(f);
+  for (size_t b = 0; b < kBodies.size(); ++b)
+    ExpectRigidInCsv(dir_ / ("rigid_" + kBodies[b] + ".csv"), b, rows, n);
+}
+
+TEST_F(ResultsWriterTest, RigidRowsAreFlushedEvery1000RowsAndAfterAKill) {
+  const auto rows = RigidRows(kBodies.size(), 1350);
+  // Cadence in this process.
+  {
+    ResultsWriter w(dir_.string(), "cadence", RunMetadata{}, TinyModel());
+    w.BeginRigid({"boulder"});
+    const fs::path csv = w.rigid_csv_path("boulder");
+    std::vector<RigidRow> one = rows;
+    for (RigidRow& row : one) row.bodies.resize(1);
+    AppendRigidRows(w, one, 0, kForceFlushRows - 1);
+    EXPECT_EQ(ReadLines(csv).size(), 1u);
+    AppendRigidRows(w, one, kForceFlushRows - 1, kForceFlushRows);
+    EXPECT_EQ(ReadLines(csv).size(), 1 + kForceFlushRows);
+    AppendRigidRows(w, one, kForceFlushRows, kForceFlushRows + 7);
+    w.Close(StageSeconds{}, 0, 0, "completed");
+    ExpectRigidInCsv(csv, 0, one, kForceFlushRows + 7);
+    hid_t f = H5Fopen(w.h5_path().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    ExpectRigidInHdf5(f, {"boulder"}, one, kForceFlushRows + 7);
+    H5Fclose(f);
+  }
+  // A child appends, snapshots after 1100 rows and is killed without Close or destructors: both
+  // files hold exactly the rows up to that flush.
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ResultsWriter w(dir_.string(), "killed", RunMetadata{}, TinyModel());
+    w.BeginRigid(kBodies);
+    for (size_t r = 0; r < rows.size(); ++r) {
+      w.AppendRigid(rows[r].time, rows[r].step, rows[r].bodies);
+      if (r + 1 == 1100) w.WriteSnapshot(TinyState(3));
+    }
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  hid_t f = H5Fopen((dir_ / "killed.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << "the file of a killed run must stay readable";
+  ExpectRigidInHdf5(f, kBodies, rows, 1100);
+  H5Fclose(f);
+  for (size_t b = 0; b < kBodies.size(); ++b)
+    ExpectRigidInCsv(dir_ / ("rigid_" + kBodies[b] + ".csv"), b, rows, 1100);
+}
+
+TEST_F(ResultsWriterTest, DestructorWithoutCloseWritesPendingRigidRowsNextToForces) {
+  const auto rows = RigidRows(1, 7);
+  const std::vector<ForceChannel> channels = {ForceChannel{"gate", {}}};
+  const auto force_rows = ForceRows(channels, 7);
+  {
+    ResultsWriter w(dir_.string(), "unclosed", RunMetadata{}, TinyModel());
+    w.BeginForces(channels);
+    w.BeginRigid({"boulder"});
+    for (size_t r = 0; r < rows.size(); ++r) {
+      w.AppendForces(force_rows[r].time, force_rows[r].step, force_rows[r].dt,
+                     force_rows[r].report);
+      w.AppendRigid(rows[r].time, rows[r].step, rows[r].bodies);
+    }
+  }
+  hid_t f = H5Fopen((dir_ / "unclosed.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  ExpectRigidInHdf5(f, {"boulder"}, rows, rows.size());
+  ExpectForcesInHdf5(f, channels, force_rows, force_rows.size());
+  H5Fclose(f);
+  ExpectRigidInCsv(dir_ / "rigid_boulder.csv", 0, rows, rows.size());
+  ExpectForcesInCsv(dir_ / "forces_gate.csv", channels[0], 0, force_rows, force_rows.size());
+}
+
+TEST_F(ResultsWriterTest, RigidSeriesMisuseThrows) {
+  ResultsWriter w(dir_.string(), "misuse", RunMetadata{}, TinyModel());
+  const auto rows = RigidRows(kBodies.size(), 1);
+  EXPECT_THROW(w.AppendRigid(0, 1, rows[0].bodies), IoError) << "before BeginRigid";
+  w.AppendRigid(0, 1, {});  // no bodies: nothing to log, no BeginRigid needed
+  EXPECT_THROW(w.BeginRigid({"a/b"}), IoError);
+  EXPECT_THROW(w.BeginRigid({""}), IoError);
+  EXPECT_THROW(w.BeginRigid({"a", "a"}), IoError);
+  EXPECT_THROW(w.BeginRigid({"big rock"}), IoError);
+  w.BeginRigid(kBodies);  // the rejected calls left nothing behind
+  EXPECT_THROW(w.BeginRigid(kBodies), IoError) << "twice";
+  std::vector<RigidBodyState> wrong = rows[0].bodies;
+  wrong.pop_back();
+  EXPECT_THROW(w.AppendRigid(0, 1, wrong), std::logic_error);
+  w.AppendRigid(rows[0].time, rows[0].step, rows[0].bodies);
+  w.Close(StageSeconds{}, 1, 0, "completed");
+  EXPECT_THROW(w.AppendRigid(0, 1, rows[0].bodies), IoError);
+  ExpectRigidInCsv(dir_ / "rigid_log-2.csv", 1, rows, 1);
+}
+
+TEST(RotationQuaternionTest, KnownRotations) {
+  const auto expect = [](const Mat3& R, std::array<Real, 4> want, Real tol) {
+    const std::array<Real, 4> q = RotationQuaternion(R);
+    for (int d = 0; d < 4; ++d) EXPECT_NEAR(q[d], want[d], tol) << d;
+  };
+  {
+    const std::array<Real, 4> q = RotationQuaternion(Mat3::Identity());
+    EXPECT_EQ(q, (std::array<Real, 4>{1, 0, 0, 0}));
+  }
+  // A rotation by theta about the unit axis a is q = (cos theta/2, sin theta/2 a) (Shoemake 1985).
+  const Real theta = 0.8;
+  expect(Mat3(Eigen::AngleAxis<Real>(theta, Vec3::UnitZ())),
+         {std::cos(theta / 2), 0, 0, std::sin(theta / 2)}, 2 * kEps);
+  // Half a turn about x: diag(1, -1, -1), trace -1 (Eigen's other branch).
+  expect(Vec3(1, -1, -1).asDiagonal(), {0, 1, 0, 0}, 0.0);
+  // theta = 4 rad > pi: cos(theta/2) < 0, so the stored one is -q (w >= 0).
+  const Vec3 a = Vec3(1, -2, 0.5).normalized();
+  const Real s = -std::sin(2.0);
+  expect(Mat3(Eigen::AngleAxis<Real>(4.0, a)), {-std::cos(2.0), s * a.x(), s * a.y(), s * a.z()},
+         4 * kEps);
+}
+
+TEST(RotationQuaternionTest, RandomRotationsRoundTrip) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  Real worst = 0;
+  for (int i = 0; i < 10000; ++i) {
+    const Vec3 axis = Vec3(u(rng), u(rng), u(rng));
+    if (axis.norm() < 1e-3) continue;
+    const Real angle = std::numbers::pi * (1 + u(rng));
+    const Mat3 R = Eigen::AngleAxis<Real>(angle, axis.normalized()).toRotationMatrix();
+    const std::array<Real, 4> q = RotationQuaternion(R);
+    const Eigen::Quaternion<Real> quat(q[0], q[1], q[2], q[3]);
+    ASSERT_GE(q[0], 0.0) << i;
+    ASSERT_NEAR(quat.norm(), 1.0, 4 * kEps) << i;
+    worst = std::max(worst, (quat.toRotationMatrix() - R).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 8 * kEps);
 }
 
 TEST(StrainInvariantsTest, IdentityIsUnstrained) {
