@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -91,6 +92,18 @@ class Progress {
   bool printed_ = false;
 };
 
+// The dynamic obstacles' names in State::rigid order (ObstacleMotion::body).
+std::vector<std::string> RigidBodyNames(const Model& model) {
+  std::vector<std::string> names;
+  for (const Obstacle& ob : model.obstacles) {
+    if (ob.motion.kind != ObstacleMotionKind::kDynamic) continue;
+    const size_t body = size_t(ob.motion.body);
+    if (names.size() <= body) names.resize(body + 1);
+    names[body] = ob.name;
+  }
+  return names;
+}
+
 }  // namespace
 
 RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
@@ -133,6 +146,9 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   // Reaction forces on the domain walls and every obstacle, logged every step (DESIGN §7).
   const std::vector<ForceChannel> channels = ForceChannels(model);
   if (!channels.empty()) writer.BeginForces(channels);
+  // Pose and velocities of every dynamic obstacle, logged every step.
+  const bool rigid = !state.rigid.empty();
+  if (rigid) writer.BeginRigid(RigidBodyNames(model));
   ContactReport forces;
   write_snapshot();
   Real next_output = model.output.every > 0 ? model.output.every : model.time.end;
@@ -159,6 +175,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
       CollectForces(model, report, forces);
       writer.AppendForces(state.time, state.step, state.dt, forces);
     }
+    if (rigid) writer.AppendRigid(state.time, state.step, state.rigid);
     if (report.removed_last_step > 0)
       Log(LogLevel::kDebug, fmt::format("{} particles left the domain", report.removed_last_step));
     const bool done = state.time >= model.time.end - end_tolerance;
@@ -217,6 +234,15 @@ void PrintSummary(const LoadedScene& scene, const RunSummary& s) {
     for (size_t f = 0; f < p.faces.size(); ++f) {
       if (p.faces[f].peak_force > 0) print("  " + s.force_channels[k].faces[f], p.faces[f]);
     }
+  }
+  // Final state of every dynamic body (its reference point; the series are in rigid_<name>.csv).
+  const std::vector<std::string> bodies = RigidBodyNames(model);
+  if (!scene.state.rigid.empty()) std::printf("   dynamic bodies at the end:\n");
+  for (size_t b = 0; b < scene.state.rigid.size() && b < bodies.size(); ++b) {
+    const RigidBodyState& r = scene.state.rigid[b];
+    std::printf("     %-22s position (%.5g, %.5g, %.5g) m, speed %.4g m/s, angular speed %.4g rad/s\n",
+                bodies[b].c_str(), r.position.x(), r.position.y(), r.position.z(),
+                r.velocity.norm(), r.angular_velocity.norm());
   }
   std::printf("   results: %s (%d snapshots)\n            %s (open in ParaView)\n",
               s.h5_path.c_str(), s.snapshots, s.xmf_path.c_str());

@@ -71,6 +71,34 @@ if [ -s "$work/out_obstacles/forces_fin.csv" ] && [ -s "$work/out_obstacles/forc
 else
   echo "FAIL run_obstacle_csv: forces_fin.csv / forces_domain.csv missing or without header"; fail=$((fail + 1))
 fi
+# A dynamic box falls 0.3 m onto the floor (Bullet contact with the walled y- side) and rests
+# with its centre half its height (0.075 m) above it: rigid_box.csv has the header and one row
+# per step, and the summary prints the final state.
+cat > "$work/falling_box.yaml" <<'YAML'
+name: falling_box
+dimension: 3
+time: {end: 0.5}
+gravity: [0, -9.81, 0]
+grid: {cell_size: 0.05}
+domain: {min: [0, 0, 0], max: [0.6, 0.6, 0.25], walls: {y-: slip}}
+materials:
+  m: {model: neo_hookean, density: 1000, bulk_modulus: 1.0e6, shear_modulus: 1.0e5}
+bodies:
+  - {name: pad, material: m, region: {box: {min: [0.45, 0, 0.05], max: [0.55, 0.1, 0.15]}}}
+obstacles:
+  - name: box
+    shape: {box: {min: [0.1, 0.3, 0.05], max: [0.25, 0.45, 0.2]}}
+    motion: {dynamic: {density: 2000}}
+YAML
+expect run_rigid_summary 0 'box +position \(0\.175, 0\.075, 0\.125\) m, speed' -- "$surge" run "$work/falling_box.yaml" --out "$work/out_rigid" --progress quiet
+rigid_csv="$work/out_rigid/rigid_box.csv"
+if [ -f "$rigid_csv" ] && head -1 "$rigid_csv" | grep -q '^time_s,step,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,wx_rad_s,wy_rad_s,wz_rad_s$' \
+  && [ "$(wc -l < "$rigid_csv")" -eq "$(wc -l < "$work/out_rigid/forces_box.csv")" ] && [ "$(wc -l < "$rigid_csv")" -gt 100 ] \
+  && awk -F, 'NR == 2 { ok = ($2 == 1 && $4 > 0.37) } END { ok = ok && NF == 15 && $4 > 0.07 && $4 < 0.08 && $6 == 1; exit !ok }' "$rigid_csv"; then
+  echo "ok   run_rigid_csv"; pass=$((pass + 1))
+else
+  echo "FAIL run_rigid_csv: rigid_box.csv missing, without header, short or not ending on the floor"; head -2 "$rigid_csv"; tail -1 "$rigid_csv"; fail=$((fail + 1))
+fi
 expect check_obstacle_named_domain 2 'obstacles\[0\]\.name.*reserved' -- "$surge" check "$work/obstacles.yaml" --set "obstacles.0.name=domain"
 expect check_geostatic_ramp 0 "bodies\[0\] 'surge': starts with a geostatic stress while gravity_ramp" -- "$surge" check "$src/scenes/column_impact_3d.yaml" --set gravity_ramp=0.2
 expect check_cylinder_2d 2 'cylinder obstacles are 3-D only' -- "$surge" check "$work/obstacles.yaml" --set "obstacles.1.shape={cylinder: {base: [0.6, 0], top: [0.6, 0.5], radius: 0.05}}"
