@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "contact/geometry.h"
+#include "support/obstacle_checks.h"
 #include "support/run_scene.h"
 
 namespace surge {
@@ -36,30 +37,9 @@ std::string MeshPath(const std::string& name) {
 // node contact itself uses for "on the surface" (contact.cpp).
 Real RoundOff(const LoadedScene& scene) { return 1e-9 * scene.model.dx; }
 
-// Largest depth of a particle inside any obstacle at the current state (0 when none is inside).
-Real MaxPenetration(const LoadedScene& scene) {
-  Real depth = 0;
-  for (const Obstacle& o : scene.model.obstacles) {
-    const ObstaclePose pose = PoseAt(o, scene.state.time);
-    for (const Vec3& x : scene.state.particles.x) {
-      const Real d = QueryObstacle(o, pose, x, scene.model.dim, 0, scene.model.dx).distance;
-      depth = std::max(depth, -d);
-    }
-  }
-  return depth;
-}
-
-Vec3 Momentum(const Particles& P) {
-  Vec3 p = Vec3::Zero();
-  for (size_t i = 0; i < P.size(); ++i) p += P.mass[i] * P.v[i];
-  return p;
-}
-
-Real TotalMass(const Particles& P) {
-  Real m = 0;
-  for (Real mp : P.mass) m += mp;
-  return m;
-}
+using testing::MaxPenetration;
+using testing::Momentum;
+using testing::TotalMass;
 
 // Least-squares slope of y(t).
 Real Slope(const std::vector<Real>& t, const std::vector<Real>& y) {
