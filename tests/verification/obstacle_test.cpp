@@ -296,5 +296,79 @@ TEST(ObstacleTest, AdhesionHoldsAHangingBlockOnlyWhenStrongEnough) {
   EXPECT_LT(strong, 0.002);  // elastic sag only
 }
 
+// --- Lid buoyancy (force on downward- and upward-facing faces) ------------------------------------
+// A 2-D tank 0.6 m wide, water ~0.2 m deep (K = 2e5 Pa, no anti-locking, h = 0.01 m, ppc 2), two
+// fixed boxes 0.16 m wide with their horizontal faces half a cell off the grid planes: A pierces the
+// surface (its bottom, a "lid", ~9.4 cells deep), B is submerged (lid ~15 cells deep, top face ~7).
+// The time-averaged force on each horizontal face is compared with p(y) A, p the hydrostatic
+// pressure of the water's own mass: m(y) = mass per metre^2 above y in a free column with
+// rho = rho0 exp(p / K) (first order in p / K < 1 %: K/g (exp(rho0 g (s - y) / K) - 1)), the
+// surface s found from the particle mass. Measured 2026-11-23: lid A -2.2 %, lid B -3.2 %, top of
+// B -2.0 %. Before the face's nodal layer included the first node row behind an off-grid face at
+// the box edges (contact.cpp), the lids lost one cell of their width: -5.7 % / -5.2 % (at h = 0.02:
+// -16 % -> -8 %). Known, not fixed: the edge node of a lid carries ~0.36 of p h instead of 0.5
+// and the interior nodes ~5 % low at 5 cells of depth, so at h = 0.02 the lids are still -7 to -8 %
+// (aligned or not); submerged vertical faces are -5 % (aligned) to -13 % (off-grid) at h = 0.01.
+constexpr const char* kLidScene = R"(name: lid_buoyancy
+dimension: 2
+time: {end: 1.6, cfl: 0.3}
+gravity: [0, -9.81]
+gravity_ramp: 0.1
+grid: {cell_size: 0.01, shape_function: quadratic_bspline, transfer: apic, update: usl}
+domain:
+  min: [0, 0]
+  max: [0.6, 0.4]
+  walls: {x-: slip, x+: slip, y-: slip, y+: slip}
+materials:
+  water: {model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e5, viscosity: 0.01,
+          antilocking: {method: none}}
+bodies:
+  - {name: water, material: water, region: {box: {min: [0, 0], max: [0.6, 0.2]}}, particles_per_cell: 2}
+obstacles:
+  - {name: A, shape: {box: {min: [0.1, 0.105], max: [0.26, 0.35]}}, motion: fixed}
+  - {name: B, shape: {box: {min: [0.34, 0.045], max: [0.5, 0.125]}}, motion: fixed}
+)";
+
+TEST(ObstacleTest, LidBuoyancyOnOffGridHorizontalFacesWithinThreePercent) {
+  constexpr Real kRho = 1000, kG = 9.81, kK = 2.0e5, kW = 0.16, kTank = 0.6;
+  constexpr Real kA = 0.105, kB0 = 0.045, kB1 = 0.125;  // lid A, lid B, top of B
+  constexpr int kYMin = 2, kYMax = 3;                   // box faces x-, x+, y-, y+
+  LoadedScene scene = LoadSceneFromString(kLidScene, "lid_buoyancy.yaml");
+  const Real mass = TotalMass(scene.state.particles);
+  // Mass per m^2 above y in a free column whose surface is s, and the surface from the mass.
+  auto above = [&](Real y, Real s) {
+    return kK / kG * (std::exp(kRho * kG * std::max(s - y, Real(0)) / kK) - 1);
+  };
+  auto total = [&](Real s) {
+    return kTank * above(0, s) - kW * above(kA, s) - kW * (above(kB0, s) - above(kB1, s));
+  };
+  Real lo = 0.1, hi = 0.3;
+  for (int k = 0; k < 60; ++k) (total(0.5 * (lo + hi)) > mass ? hi : lo) = 0.5 * (lo + hi);
+  const Real s = 0.5 * (lo + hi);
+  auto load = [&](Real y) { return kG * above(y, s) * kW; };  // p(y) x width [N/m]
+  Real lid_a = 0, lid_b = 0, top_b = 0;
+  int n = 0;
+  testing::RunUntil(scene, 1.6, [&](const State& st, const StepReport& r) {
+    if (st.time < 1.0) return;
+    lid_a += r.obstacles.at(0).faces.at(kYMin).force.y();
+    lid_b += r.obstacles.at(1).faces.at(kYMin).force.y();
+    top_b += -r.obstacles.at(1).faces.at(kYMax).force.y();
+    ++n;
+  });
+  lid_a /= n;
+  lid_b /= n;
+  top_b /= n;
+  std::printf("lid buoyancy (h = 0.01 m, faces half a cell off the grid, surface %.4f m): lid A "
+              "%.3f N/m (p A %.3f, %+.2f %%), lid B %.3f N/m (%.3f, %+.2f %%), top of B %.3f N/m "
+              "(%.3f, %+.2f %%); deepest particle inside %.2e m\n",
+              s, lid_a, load(kA), 100 * (lid_a / load(kA) - 1), lid_b, load(kB0),
+              100 * (lid_b / load(kB0) - 1), top_b, load(kB1), 100 * (top_b / load(kB1) - 1),
+              MaxPenetration(scene));
+  EXPECT_NEAR(lid_a, load(kA), 0.03 * load(kA));
+  EXPECT_NEAR(lid_b, load(kB0), 0.04 * load(kB0));
+  EXPECT_NEAR(top_b, load(kB1), 0.03 * load(kB1));
+  EXPECT_EQ(MaxPenetration(scene), 0);
+}
+
 }  // namespace
 }  // namespace surge
