@@ -271,7 +271,7 @@ TEST(ObstacleParserTest, UnknownKeys) {
               "unknown key 'torus' (expected one of: plane, box, sphere, cylinder, polygon, mesh)");
   ExpectError(WithObstacle(3, "{name: c, shape: {mesh: {file: " + kMeshDir + "unit_cube.stl, scal: 2}}}\n"), 13,
               "obstacles[0].shape.mesh.scal",
-              "unknown key 'scal' (expected one of: file, scale, rotate_deg, translate, one_sided)");
+              "unknown key 'scal' (expected one of: file, scale, rotate_deg, translate, one_sided, faces)");
   ExpectError(Base(3) + "obstacles: {name: c}\n", 12, "obstacles", "expected a list of obstacles");
 }
 
@@ -344,7 +344,7 @@ TEST(ObstacleParserTest, BadMotionSpellings) {
               15, "obstacles[0].motion.dynamic", "a plane is infinite and cannot be dynamic");
   ExpectError(WithObstacle(3, head + "    motion: {prescribed: {velocity: [1, 0, 0], spin: 3}}\n"), 15,
               "obstacles[0].motion.prescribed.spin",
-              "unknown key 'spin' (expected one of: velocity, angular_velocity_deg, center)");
+              "unknown key 'spin' (expected one of: velocity, angular_velocity_deg, center, table)");
   ExpectError(WithObstacle(3, head + "    motion: {prescribed: {velocity: 1}}\n"), 15,
               "obstacles[0].motion.prescribed.velocity", "expected a list of 3 numbers [m/s]");
   ExpectError(WithObstacle(3, head + "    motion: {prescribed: {angular_velocity_deg: 90}}\n"), 15,
