@@ -48,6 +48,19 @@ inline void Constrain(const SurfaceQuery& q, const ObstacleContact& law, const V
   }
 }
 
+// Broad phase: the blocks (in block order) whose node box meets [lo, hi] widened by tol.
+void BlocksMeeting(const SparseGrid& grid, Real dx, int dim, const Vec3& lo, const Vec3& hi,
+                   Real tol, std::vector<int32_t>& out) {
+  out.clear();
+  for (size_t b = 0; b < grid.block_count(); ++b) {
+    const Vec3 blo = grid.block_origin[b].cast<Real>() * dx;
+    const Vec3 bhi = blo + Vec3::Constant((kBlockDim - 1) * dx);
+    bool overlap = true;
+    for (int a = 0; a < dim; ++a) overlap &= bhi[a] >= lo[a] - tol && blo[a] <= hi[a] + tol;
+    if (overlap) out.push_back(int32_t(b));
+  }
+}
+
 Real BaseElevation(const Obstacle& o, const ObstaclePose& pose, const Vec3& up) {
   Vec3 lo, hi;
   PosedBounds(o, pose, lo, hi);
@@ -88,14 +101,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx,
     // Broad phase: blocks whose node box meets the obstacle's posed bounds.
     Vec3 lo, hi;
     PosedBounds(ob, pose, lo, hi);
-    scratch.blocks.clear();
-    for (size_t b = 0; b < nb; ++b) {
-      const Vec3 blo = grid.block_origin[b].cast<Real>() * ctx.dx;
-      const Vec3 bhi = blo + Vec3::Constant((kBlockDim - 1) * ctx.dx);
-      bool overlap = true;
-      for (int a = 0; a < model.dim; ++a) overlap &= bhi[a] >= lo[a] - tol && blo[a] <= hi[a] + tol;
-      if (overlap) scratch.blocks.push_back(int32_t(b));
-    }
+    BlocksMeeting(grid, ctx.dx, model.dim, lo, hi, tol, scratch.blocks);
     const int faces = int(ob.faces.size());
     const size_t stride = kHeader + kFaceSlots * size_t(faces);
     scratch.partial.assign(scratch.blocks.size() * stride, 0);
@@ -192,18 +198,9 @@ void SumSensors(const Model& model, const StepContext& ctx, const SparseGrid& gr
   const Real cell_area = model.dim == 3 ? ctx.dx * ctx.dx : ctx.dx;  // h^(d-1), (7.15)
   const Vec3 up = UpDirection(model);
   out.assign(model.sensors.size(), ObstacleForce{});
-  const size_t nb = grid.block_count();
   for (size_t s = 0; s < model.sensors.size(); ++s) {
     const Sensor& sensor = model.sensors[s];
-    scratch.blocks.clear();
-    for (size_t b = 0; b < nb; ++b) {
-      const Vec3 blo = grid.block_origin[b].cast<Real>() * ctx.dx;
-      const Vec3 bhi = blo + Vec3::Constant((kBlockDim - 1) * ctx.dx);
-      bool overlap = true;
-      for (int a = 0; a < model.dim; ++a)
-        overlap &= bhi[a] >= sensor.min[a] - tol && blo[a] <= sensor.max[a] + tol;
-      if (overlap) scratch.blocks.push_back(int32_t(b));
-    }
+    BlocksMeeting(grid, ctx.dx, model.dim, sensor.min, sensor.max, tol, scratch.blocks);
     const size_t stride = kHeader;
     scratch.partial.assign(scratch.blocks.size() * stride, 0);
     const Vec3 center = 0.5 * (sensor.min + sensor.max);

@@ -13,29 +13,14 @@
 #include <vector>
 
 #include "contact/geometry.h"
+#include "support/obstacle_checks.h"
 #include "support/run_scene.h"
 
 namespace surge {
 namespace {
 
-// Largest depth of a particle inside any obstacle at the current state (0 when none is inside).
-Real MaxPenetration(const LoadedScene& scene) {
-  Real depth = 0;
-  for (const Obstacle& o : scene.model.obstacles) {
-    const ObstaclePose pose = PoseAt(o, scene.state.time);
-    for (const Vec3& x : scene.state.particles.x) {
-      const Real d = QueryObstacle(o, pose, x, scene.model.dim, 0, scene.model.dx).distance;
-      depth = std::max(depth, -d);
-    }
-  }
-  return depth;
-}
-
-Real TotalMass(const Particles& P) {
-  Real m = 0;
-  for (Real mp : P.mass) m += mp;
-  return m;
-}
+using testing::MaxPenetration;
+using testing::TotalMass;
 
 // --- Hydrostatic thrust ------------------------------------------------------------------------
 // Water (reduced bulk modulus, node-based anti-locking: the fluid default) fills x in [0, 0.1]
