@@ -16,6 +16,7 @@
 #include "grid/sparse_grid.h"
 #include "io/results_writer.h"
 #include "scene/scene.h"
+#include "step/stages.h"
 #include "step/step.h"
 #include "surge/version.h"
 #include "transfer/transfer.h"
@@ -65,6 +66,19 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
                                                       : "PIC/FLIP");
   std::printf("materials  %zu, bodies %zu\n", m.materials.size(), m.bodies.size());
   std::printf("particles  %zu\n", P.size());
+  // Structures and what the force log will hold (docs/results-format.md, "Force series").
+  const std::vector<ForceChannel> channels = ForceChannels(m);
+  if (!channels.empty()) {
+    size_t dynamic = 0, prescribed = 0;
+    for (const Obstacle& o : m.obstacles) {
+      dynamic += o.motion.kind == ObstacleMotionKind::kDynamic;
+      prescribed += o.motion.kind == ObstacleMotionKind::kPrescribed;
+    }
+    std::string names;
+    for (const ForceChannel& c : channels) names += (names.empty() ? "" : ", ") + c.name;
+    std::printf("structures %zu obstacles (%zu prescribed, %zu dynamic), %zu sensors; force log: %s\n",
+                m.obstacles.size(), prescribed, dynamic, m.sensors.size(), names.c_str());
+  }
   std::printf("grid       %zu active blocks (8^3 nodes), %zu nodes with mass\n",
               grid.block_count(), grid.ActiveNodeCount());
   std::printf("time step  %.4g s (CFL %.2f) -> about %.0f steps to t = %g s\n", dt, m.time.cfl,
