@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <variant>
 
 #include "contact/geometry.h"
 #include "core/parallel.h"
@@ -106,6 +107,11 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx,
     const size_t stride = kHeader + kFaceSlots * size_t(faces);
     scratch.partial.assign(scratch.blocks.size() * stride, 0);
     const Vec3 ref = pose.ToWorld(ob.reference_point);
+    // Only these shapes report several faces at a point (planes, spheres, meshes: one).
+    const bool multi_face = std::holds_alternative<BoxShape>(ob.shape) ||
+                            std::holds_alternative<CylinderShape>(ob.shape) ||
+                            std::holds_alternative<PolygonShape>(ob.shape);
+    const bool keep_reaction = report && !model.sensors.empty();  // not again in MUSL re-map
     ParallelFor(scratch.blocks.size(), 1, [&](size_t c) {
       const size_t b = size_t(scratch.blocks[c]);
       Real* part = &scratch.partial[c * stride];
@@ -132,7 +138,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx,
         // (aligned faces) are not added: the aligned layer is unchanged. Mast 2013 eq. (7.15)
         // counts the same layer (one node row of area h^(d-1) per face); seed spec §5.2 [REC]
         // constrains the span of every active normal at edges.
-        if (q.distance > tol - ctx.dx) {
+        if (multi_face && q.distance > tol - ctx.dx) {
           const Real tie = ctx.dx + q.distance - 2 * tol;  // faces with distance > -h + tol
           if (tie > tol) q = QueryObstacle(ob, pose, x, model.dim, tie, 2 * ctx.dx);
         }
@@ -143,7 +149,7 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx,
         Constrain(q, ob.contact, pose.PointVelocity(x), hold, v, dv);
         // Force on the structure: the momentum the contact removed, m (v_u - v_c) / dt.
         const Vec3 f = m * (before - v) / ctx.dt;
-        if (report) grid.reaction[i] += f;  // not again in the MUSL re-application
+        if (keep_reaction) grid.reaction[i] += f;  // for the force sensors
         const Vec3 tq = (x - ref).cross(f);
         for (int d = 0; d < 3; ++d) {
           part[kFx + d] += f[d];
@@ -317,6 +323,7 @@ int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ct
         r.torque += m.torque;
         if (m.face >= 0 && size_t(m.face) < r.faces.size()) r.faces[size_t(m.face)].force += m.force;
       }
+      if (model.sensors.empty()) continue;  // the nodal reaction is read by sensors only
       const Vec3i node = (P.x[m.particle] * ctx.inv_dx).array().round().cast<int>();
       const int32_t owner = grid.particle_block[m.particle];
       const Vec3i local = node - grid.block_origin[size_t(owner)];

@@ -50,7 +50,8 @@ struct SparseGrid {
   std::vector<Vec3> velocity;       // v_{i,n} = p_i / m_i [m/s]           (2.13)
   std::vector<Vec3> velocity_new;   // v_{i,n+1} after boundary conditions (2.14)
   std::vector<Vec3> reaction;       // force on the structures (walls, obstacles) at the node,
-                                    // m (v_u - v_c) / dt, this step [N]   (spec §5.3)
+                                    // m (v_u - v_c) / dt, this step [N]   (spec §5.3);
+                                    // written only when the scene has force sensors
 
   // --- Scratch reused by RebuildGrid (no allocation per step after warm-up). ---
   std::vector<Vec3i> particle_block_coord;

@@ -83,6 +83,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
   const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, robust to round-off of i*dx
   const Real g = model.gravity.norm();
   const Vec3 up = g > 0 ? Vec3(-model.gravity / g) : Vec3::UnitY();
+  const bool keep_reaction = !model.sensors.empty();  // SparseGrid::reaction: sensors only
   const size_t nb = grid.block_count();
   // Per-block partial reactions, summed in block order afterwards (deterministic).
   std::vector<SparseGrid::WallPartial>& partial = grid.wall_partials;
@@ -96,7 +97,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
       if (m <= 0) {
         grid.velocity[i].setZero();
         grid.velocity_new[i].setZero();
-        grid.reaction[i].setZero();
+        if (keep_reaction) grid.reaction[i].setZero();
         continue;
       }
       const Vec3 v = grid.momentum[i] / m;                        // (2.13)
@@ -129,7 +130,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
         }
       }
       grid.velocity_new[i] = vc;
-      grid.reaction[i] = m * (vu - vc) / ctx.dt;  // on the walls; zero away from them
+      if (keep_reaction) grid.reaction[i] = m * (vu - vc) / ctx.dt;  // walls' share; 0 elsewhere
     }
   });
   report = WallReport{};
