@@ -409,6 +409,19 @@ class Parser {
     return v;
   }
 
+  // `name` of list item `node` (list key[i]) is not among the names already in `items`.
+  template <class T>
+  void ExpectNewName(const std::vector<T>& items, const std::string& name, const YAML::Node& node,
+                     const std::string& list_key, size_t i, const std::string& what) const {
+    for (size_t j = 0; j < items.size(); ++j) {
+      if (items[j].name == name) {
+        Fail(node["name"], Child(Index(list_key, i), "name"),
+             "duplicate " + what + " name '" + name + "' (also " + list_key + "[" +
+                 std::to_string(j) + "])");
+      }
+    }
+  }
+
   Wall ParseWall(const YAML::Node& n, const std::string& path) const;
   MaterialSpec ParseMaterial(const YAML::Node& n, const std::string& path) const;
   void ParseElasticPair(const YAML::Node& n, const std::string& path, MaterialSpec& m) const;
@@ -1048,12 +1061,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
     }
     for (size_t i = 0; i < bs.size(); ++i) {
       BodySpec b = ParseBody(bs[i], Index("bodies", i), spec);
-      for (size_t j = 0; j < spec.bodies.size(); ++j) {
-        if (spec.bodies[j].name == b.name) {
-          Fail(bs[i]["name"], Child(Index("bodies", i), "name"),
-               "duplicate body name '" + b.name + "' (also bodies[" + std::to_string(j) + "])");
-        }
-      }
+      ExpectNewName(spec.bodies, b.name, bs[i], "bodies", i, "body");
       spec.bodies.push_back(std::move(b));
     }
   }
@@ -1063,12 +1071,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
     if (!os.IsSequence()) Fail(os, "obstacles", "expected a list of obstacles, got " + Describe(os));
     for (size_t i = 0; i < os.size(); ++i) {
       ObstacleSpec o = ParseObstacle(os[i], Index("obstacles", i));
-      for (size_t j = 0; j < spec.obstacles.size(); ++j) {
-        if (spec.obstacles[j].name == o.name) {
-          Fail(os[i]["name"], Child(Index("obstacles", i), "name"),
-               "duplicate obstacle name '" + o.name + "' (also obstacles[" + std::to_string(j) + "])");
-        }
-      }
+      ExpectNewName(spec.obstacles, o.name, os[i], "obstacles", i, "obstacle");
       spec.obstacles.push_back(std::move(o));
     }
   }
