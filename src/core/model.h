@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "contact/obstacle.h"
+#include "core/analysis.h"
 #include "core/math.h"
 #include "materials/material_params.h"
 
@@ -85,6 +86,7 @@ struct Model {
   std::vector<Obstacle> obstacles;       // rigid structures (src/contact), in scene order
   std::vector<Sensor> sensors;           // force sensors (src/contact), in scene order
   OutputPlan output;
+  AnalysisSettings analysis;  // force analysis, defaults filled in (scene `analysis`, issue #6)
 };
 
 // Load factor of the external-force ramp at time t (seed App. B.2.3 ExternalForceRamp).

@@ -58,6 +58,27 @@ struct SeededBody {
 
 std::string ObstaclePath(size_t o) { return "obstacles[" + std::to_string(o) + "]"; }
 
+// model.analysis: the scene's `analysis` with its defaults; the face must be one of the
+// structure's (docs/scene-reference.md). Pre: model.obstacles, sensors and walls are built.
+void BuildAnalysis(const SceneSpec& spec, Model& model) {
+  model.analysis = ResolveAnalysis(spec, spec.analysis.settings).settings;
+  const AnalysisSettings& a = model.analysis;
+  if (a.face.empty()) return;
+  std::vector<std::string> faces;
+  if (a.structure == "domain") {
+    for (int f = 0; f < 2 * model.dim; ++f)
+      if (model.walls[f].kind != WallKind::kOpen) faces.push_back(FaceName(Face(f)));
+  }
+  for (const Obstacle& o : model.obstacles)
+    if (o.name == a.structure) faces = o.faces;
+  if (std::find(faces.begin(), faces.end(), a.face) != faces.end()) return;
+  std::string list;
+  for (const std::string& f : faces) list += (list.empty() ? "" : ", ") + f;
+  Fail(spec.analysis.face_loc, "analysis.face",
+       "structure '" + a.structure + "' has no face '" + a.face + "' (" +
+           (faces.empty() ? std::string("it has no faces") : "its faces: " + list) + ")");
+}
+
 // Obstacle o of the spec as the run sees it: shape (meshes read, transformed and given their
 // distance field), faces, bounds, reference point and motion.
 Obstacle BuildObstacle(const SceneSpec& spec, size_t index) {
@@ -298,6 +319,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   model.output.every = spec.output.every;
   model.output.vdb = spec.output.vdb;
   model.output.energy = spec.output.energy;
+  BuildAnalysis(spec, model);
 
   // Seed every body; ids follow seeding order (body by body).
   std::vector<SeededBody> seeded;
@@ -349,6 +371,79 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
     }
     if (next > begin) state.groups.push_back(MaterialGroup{static_cast<int>(m), begin, next});
   }
+}
+
+// --- analysis defaults (docs/scene-reference.md, `analysis`) -------------------------------
+
+namespace {
+
+// Index of the coordinate axis g points along, or -1 when g is zero or not axis-aligned.
+int GravityAxis(const Vec3& g) {
+  for (int a = 0; a < 3; ++a) {
+    if (g[a] != 0 && g[(a + 1) % 3] == 0 && g[(a + 2) % 3] == 0) return a;
+  }
+  return -1;
+}
+
+}  // namespace
+
+ResolvedAnalysis ResolveAnalysis(const SceneSpec& spec, const AnalysisSettings& written) {
+  ResolvedAnalysis out;
+  AnalysisSettings& s = out.settings;
+  s = written;
+  std::string& source = out.reference_source;
+  const auto note = [&](const std::string& what) { source += (source.empty() ? "" : "; ") + what; };
+  if (s.structure.empty()) {
+    s.structure = !spec.obstacles.empty() ? spec.obstacles.front().name
+                  : !spec.sensors.empty() ? spec.sensors.front().name
+                                          : "domain";
+  }
+  ReferenceValues& r = s.reference;
+  const BodySpec* body = spec.bodies.empty() ? nullptr : &spec.bodies.front();
+  if (!r.density && body) {
+    const MaterialSpec& m = spec.materials.at(size_t(body->material_index));
+    r.density = m.density;
+    note("density: materials." + m.name + ".density");
+  }
+  if (!r.gravity && spec.gravity.norm() > 0) {
+    r.gravity = spec.gravity.norm();
+    note("gravity: |gravity|");
+  }
+  if (!r.velocity && body && body->velocity.norm() > 0) {
+    r.velocity = body->velocity.norm();
+    note("velocity: |bodies[0].velocity|");
+  }
+  if (!r.k0 && body && body->geostatic_k0) {
+    r.k0 = *body->geostatic_k0;
+    note("k0: bodies[0].initial_stress.geostatic.k0");
+  }
+  const int g_axis = GravityAxis(spec.gravity);
+  if (!r.width) {
+    if (spec.dimension == 2) {
+      r.width = 1.0;  // 2-D forces and areas are per metre of thickness
+      note("width: 1 m (2-D, per metre)");
+    } else if (const auto n_face = s.face.size() == 2 && g_axis >= 0 ? s.face[0] - 'x' : -1;
+               n_face >= 0 && n_face < 3 && n_face != g_axis) {
+      for (const ObstacleSpec& o : spec.obstacles) {
+        const BoxRegion* box = std::get_if<BoxRegion>(&o.shape);
+        if (o.name != s.structure || !box) continue;
+        const int across = 3 - n_face - g_axis;  // the axis normal to both the face and gravity
+        // The part inside the domain: a column sunk through a side wall is exposed only there.
+        r.width = std::min(box->max[across], spec.domain.max[across]) -
+                  std::max(box->min[across], spec.domain.min[across]);
+        note("width: obstacle '" + o.name + "' box extent along " + std::string(1, char('x' + across)) +
+             " inside the domain");
+      }
+    }
+  }
+  if (!r.height && body && g_axis >= 0) {
+    if (const BoxRegion* box = std::get_if<BoxRegion>(&body->region)) {
+      r.height = std::min(box->max[g_axis], spec.domain.max[g_axis]) -
+                 std::max(box->min[g_axis], spec.domain.min[g_axis]);
+      note("height: bodies[0] box extent along gravity");
+    }
+  }
+  return out;
 }
 
 }  // namespace surge

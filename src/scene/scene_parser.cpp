@@ -54,6 +54,18 @@ constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockin
                                                              {"cell", AntiLockingMethod::kCell}};
 constexpr EnumName<AntiLockingStrain> kAntiLockingStrainNames[] = {
     {"total", AntiLockingStrain::kTotal}, {"increment", AntiLockingStrain::kIncrement}};
+constexpr EnumName<ForceComponent> kComponentNames[] = {{"x", ForceComponent::kX},
+                                                        {"y", ForceComponent::kY},
+                                                        {"z", ForceComponent::kZ},
+                                                        {"normal", ForceComponent::kNormal},
+                                                        {"magnitude", ForceComponent::kMagnitude}};
+
+// "x-", "x+", ..., "z+": the faces whose normal is a coordinate axis.
+bool AxisFace(const std::string& face) {
+  return face.size() == 2 && (face[0] == 'x' || face[0] == 'y' || face[0] == 'z') &&
+         (face[1] == '-' || face[1] == '+');
+}
+
 constexpr EnumName<WallKind> kWallNames[] = {{"open", WallKind::kOpen},
                                              {"slip", WallKind::kSlip},
                                              {"no_slip", WallKind::kNoSlip},
@@ -428,6 +440,7 @@ class Parser {
   RegionShape ParseRegion(const YAML::Node& n, const std::string& path) const;
   BodySpec ParseBody(const YAML::Node& n, const std::string& path, const SceneSpec& spec) const;
   ObstacleSpec ParseObstacle(const YAML::Node& n, const std::string& path) const;
+  AnalysisSpec ParseAnalysis(const YAML::Node& n, const SceneSpec& spec) const;
   ObstacleShapeSpec ParseObstacleShape(const YAML::Node& n, const std::string& path) const;
 
   std::string source_;
@@ -963,11 +976,124 @@ ObstacleSpec Parser::ParseObstacle(const YAML::Node& n, const std::string& path)
   return o;
 }
 
+// `analysis:` (docs/scene-reference.md). The structure must be in the force log (checked here);
+// its face is checked by the builder, which knows every obstacle's face names.
+AnalysisSpec Parser::ParseAnalysis(const YAML::Node& n, const SceneSpec& spec) const {
+  AnalysisSpec a;
+  a.present = true;
+  a.loc = Loc(n, "analysis");
+  AnalysisSettings& s = a.settings;
+  ExpectMap(n, "analysis", {"structure", "face", "component", "reference", "smoothing", "steady_state"});
+  if (n["structure"]) {
+    s.structure = Identifier(n["structure"], "analysis.structure");
+    a.structure_loc = Loc(n["structure"], "analysis.structure");
+    std::vector<std::string> names = {"domain"};
+    for (const ObstacleSpec& o : spec.obstacles) names.push_back(o.name);
+    for (const SensorSpec& o : spec.sensors) names.push_back(o.name);
+    if (std::find(names.begin(), names.end(), s.structure) == names.end()) {
+      Fail(n["structure"], "analysis.structure",
+           "unknown structure '" + s.structure + "' (expected one of: " + Join(names) + ")");
+    }
+  }
+  if (n["face"]) {
+    s.face = String(n["face"], "analysis.face");
+    a.face_loc = Loc(n["face"], "analysis.face");
+  }
+  if (n["component"]) {
+    s.component = Enum(n["component"], "analysis.component", kComponentNames);
+    if (*s.component == ForceComponent::kNormal && !AxisFace(s.face)) {
+      Fail(n["component"], "analysis.component",
+           "component normal needs an axis face (face: x-, x+, y-, y+, z- or z+)" +
+               (s.face.empty() ? std::string() : ", got face '" + s.face + "'"));
+    }
+    if (*s.component == ForceComponent::kZ && dim_ == 2) {
+      Fail(n["component"], "analysis.component", "2-D forces have no z component");
+    }
+  }
+  if (n["reference"]) {
+    const YAML::Node r = n["reference"];
+    const std::string rp = "analysis.reference";
+    ExpectMap(r, rp, {"velocity", "density", "width", "height", "area", "k0", "gravity"});
+    ReferenceValues& v = s.reference;
+    if (r["velocity"]) v.velocity = Positive(r["velocity"], Child(rp, "velocity"), "m/s");
+    if (r["density"]) v.density = Positive(r["density"], Child(rp, "density"), "kg/m^3");
+    if (r["width"]) {
+      v.width = Positive(r["width"], Child(rp, "width"), "m");
+      if (dim_ == 2 && *v.width != 1) {
+        Fail(r["width"], Child(rp, "width"),
+             "2-D forces are per metre of thickness: the width is 1 m (leave it out)");
+      }
+    }
+    if (r["height"]) v.height = Positive(r["height"], Child(rp, "height"), "m");
+    if (r["area"]) v.area = Positive(r["area"], Child(rp, "area"), dim_ == 2 ? "m^2/m" : "m^2");
+    if (r["k0"]) v.k0 = Positive(r["k0"], Child(rp, "k0"), "-");
+    if (r["gravity"]) v.gravity = Positive(r["gravity"], Child(rp, "gravity"), "m/s^2");
+  }
+  if (n["smoothing"]) {
+    const YAML::Node m = n["smoothing"];
+    const std::string mp = "analysis.smoothing";
+    SmoothingSettings& f = s.smoothing;
+    if (m.IsScalar() && m.Scalar() == "none") {
+      f.kind = SmoothingKind::kNone;
+    } else {
+      const std::vector<std::string> kinds = {"moving_average", "exponential", "low_pass"};
+      if (!m.IsMap()) {
+        Fail(m, mp, "expected none or a map with one of: " + Join(kinds) + ", got " + Describe(m));
+      }
+      ExpectMap(m, mp, {"moving_average", "exponential", "low_pass", "order"});
+      int given = 0;
+      for (const std::string& k : kinds) given += bool(m[k]);
+      if (given != 1) {
+        Fail(m, mp, "expected exactly one of: " + Join(kinds) + " (got " + std::to_string(given) + ")");
+      }
+      if (m["moving_average"]) {
+        f.kind = SmoothingKind::kMovingAverage;
+        f.window = Positive(m["moving_average"], Child(mp, "moving_average"), "s");
+      } else if (m["exponential"]) {
+        f.kind = SmoothingKind::kExponential;
+        f.time_constant = Positive(m["exponential"], Child(mp, "exponential"), "s");
+      } else {
+        f.kind = SmoothingKind::kLowPass;
+        f.cutoff = Positive(m["low_pass"], Child(mp, "low_pass"), "Hz");
+      }
+      if (m["order"]) {
+        if (f.kind != SmoothingKind::kLowPass) {
+          Fail(m["order"], Child(mp, "order"), "order applies only to low_pass");
+        }
+        f.order = static_cast<int>(Integer(m["order"], Child(mp, "order"), 1, 2));
+      }
+    }
+  }
+  if (n["steady_state"]) {
+    const YAML::Node m = n["steady_state"];
+    const std::string mp = "analysis.steady_state";
+    SteadyStateSettings& ss = s.steady_state;
+    ExpectMap(m, mp, {"average", "min_window", "tolerance", "window"});
+    if (m["average"]) ss.average = NonNegative(m["average"], Child(mp, "average"), "s");
+    if (m["min_window"]) ss.min_window = Positive(m["min_window"], Child(mp, "min_window"), "s");
+    if (m["tolerance"]) {
+      ss.tolerance = Ranged(m["tolerance"], Child(mp, "tolerance"), "-", 0, false, 1, true);
+    }
+    if (m["window"]) {
+      const YAML::Node w = m["window"];
+      const std::string wp = Child(mp, "window");
+      if (!w.IsSequence() || w.size() != 2) {
+        Fail(w, wp, "expected a list of 2 times [t0, t1] [s], got " + Describe(w));
+      }
+      const Real t0 = NonNegative(w[0], Index(wp, 0), "s");
+      const Real t1 = Number(w[1], Index(wp, 1), "s");
+      if (!(t1 > t0)) Fail(w, wp, "t1 must exceed t0 [s]");
+      ss.window = std::array<Real, 2>{t0, t1};
+    }
+  }
+  return a;
+}
+
 SceneSpec Parser::Parse(const YAML::Node& root) {
   SceneSpec spec;
   const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
                                         "grid",   "domain",    "materials", "bodies",  "obstacles",
-                                        "sensors", "output", "parameters"};
+                                        "sensors", "output", "analysis", "parameters"};
   if (!root.IsDefined() || root.IsNull()) {
     throw SceneError(source_, 0, 0, "", "the scene is empty (expected a map with keys " + Join(top) + ")");
   }
@@ -1115,6 +1241,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
     if (o["vdb"]) spec.output.vdb = Bool(o["vdb"], "output.vdb");
     if (o["energy"]) spec.output.energy = Bool(o["energy"], "output.energy");
   }
+  if (root["analysis"]) spec.analysis = ParseAnalysis(root["analysis"], spec);
   return spec;
 }
 
@@ -1435,6 +1562,53 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   e << YAML::Key << "vdb" << YAML::Value << spec.output.vdb;
   e << YAML::Key << "energy" << YAML::Value << spec.output.energy;
   e << YAML::EndMap;
+  if (spec.analysis.present) {  // as written; smoothing and steady state with their defaults
+    const AnalysisSettings& a = spec.analysis.settings;
+    e << YAML::Key << "analysis" << YAML::Value << YAML::BeginMap;
+    if (!a.structure.empty()) e << YAML::Key << "structure" << YAML::Value << a.structure;
+    if (!a.face.empty()) e << YAML::Key << "face" << YAML::Value << a.face;
+    if (a.component) {
+      e << YAML::Key << "component" << YAML::Value << NameOf(kComponentNames, *a.component);
+    }
+    const ReferenceValues& r = a.reference;
+    const std::pair<const char*, const std::optional<Real>*> refs[] = {
+        {"velocity", &r.velocity}, {"density", &r.density}, {"width", &r.width},
+        {"height", &r.height},     {"area", &r.area},       {"k0", &r.k0},
+        {"gravity", &r.gravity}};
+    e << YAML::Key << "reference" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    for (const auto& [key, value] : refs) {
+      if (*value) e << YAML::Key << key << YAML::Value << Num(**value);
+    }
+    e << YAML::EndMap;
+    const SmoothingSettings& f = a.smoothing;
+    e << YAML::Key << "smoothing" << YAML::Value;
+    switch (f.kind) {
+      case SmoothingKind::kNone: e << "none"; break;
+      case SmoothingKind::kMovingAverage:
+        e << YAML::Flow << YAML::BeginMap << YAML::Key << "moving_average" << YAML::Value
+          << Num(f.window) << YAML::EndMap;
+        break;
+      case SmoothingKind::kExponential:
+        e << YAML::Flow << YAML::BeginMap << YAML::Key << "exponential" << YAML::Value
+          << Num(f.time_constant) << YAML::EndMap;
+        break;
+      case SmoothingKind::kLowPass:
+        e << YAML::Flow << YAML::BeginMap << YAML::Key << "low_pass" << YAML::Value
+          << Num(f.cutoff) << YAML::Key << "order" << YAML::Value << f.order << YAML::EndMap;
+        break;
+    }
+    const SteadyStateSettings& ss = a.steady_state;
+    e << YAML::Key << "steady_state" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    e << YAML::Key << "average" << YAML::Value << Num(ss.average);
+    e << YAML::Key << "min_window" << YAML::Value << Num(ss.min_window);
+    e << YAML::Key << "tolerance" << YAML::Value << Num(ss.tolerance);
+    if (ss.window) {
+      e << YAML::Key << "window" << YAML::Value << YAML::Flow << YAML::BeginSeq
+        << Num((*ss.window)[0]) << Num((*ss.window)[1]) << YAML::EndSeq;
+    }
+    e << YAML::EndMap;
+    e << YAML::EndMap;
+  }
   if (!spec.parameters.empty()) {  // values already substituted; kept for the record
     e << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
     for (const auto& [name, value] : spec.parameters) e << YAML::Key << name << YAML::Value << Num(value);

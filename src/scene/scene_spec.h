@@ -15,6 +15,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/analysis.h"
 #include "core/math.h"
 #include "core/model.h"
 #include "materials/material_params.h"
@@ -223,6 +224,15 @@ struct OutputSpec {
   bool energy = true;
 };
 
+// `analysis:` (docs/scene-reference.md): what `surge forces` and the end of `surge run` analyse.
+// `settings` holds the values as written (unset reference values stay unset); ResolveAnalysis
+// fills the defaults.
+struct AnalysisSpec {
+  bool present = false;  // the scene has an `analysis` section
+  AnalysisSettings settings;
+  SourceLoc loc, structure_loc, face_loc;
+};
+
 struct SceneSpec {
   std::string name;
   int dimension = 3;
@@ -236,6 +246,7 @@ struct SceneSpec {
   std::vector<ObstacleSpec> obstacles;  // in file order; Model::obstacles has the same order
   std::vector<SensorSpec> sensors;      // in file order; Model::sensors has the same order
   OutputSpec output;
+  AnalysisSpec analysis;
   // `parameters:` in file order, after --set overrides; `${expr}` values were evaluated over
   // them before validation (scene_expressions.h).
   std::vector<std::pair<std::string, Real>> parameters;
@@ -250,6 +261,19 @@ SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
 // Anti-locking of a material: as written, else node-based volumetric on the total strain for the
 // Newtonian fluid (smooth pressure and wall forces, seed §3.7) and none for every other model.
 AntiLocking ResolvedAntiLocking(const MaterialSpec& m);
+
+// The analysis settings of a scene with the defaults filled in (docs/scene-reference.md,
+// `analysis`): `written` is spec.analysis.settings, possibly changed by the caller (the options
+// of `surge forces`). Structure: the first obstacle, else sensor, else "domain". Reference
+// values not written: density of the first body's material, |gravity|, |velocity| of the first
+// body (if not 0), k0 of its geostatic start, width 1 in 2-D (per metre) or, for an axis face of
+// a box obstacle with gravity along an axis, the box's extent across both, height the first
+// body's box extent along gravity. `reference_source` says where each default came from.
+struct ResolvedAnalysis {
+  AnalysisSettings settings;
+  std::string reference_source;  // e.g. "density: materials.sand; velocity: bodies[0].velocity"
+};
+ResolvedAnalysis ResolveAnalysis(const SceneSpec& spec, const AnalysisSettings& written);
 
 // The spec as YAML with every default written out; ParseSceneSpec reads it back to an equal spec.
 std::string SceneSpecToYaml(const SceneSpec& spec);
