@@ -1,4 +1,4 @@
-// surge: command-line entry point (CLI11). Subcommands: run, check, info.
+// surge: command-line entry point (CLI11). Subcommands: run, check, info, forces.
 #include <CLI/CLI.hpp>
 #include <tbb/version.h>
 
@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/forces_command.h"
 #include "app/run.h"
 #include "app/scene_warnings.h"
 #include "core/log.h"
@@ -149,6 +150,9 @@ int Main(int argc, char** argv) {
 
   CLI::App* info = app.add_subcommand("info", "Version, build options and library versions");
 
+  ForcesCommandOptions forces_options;
+  CLI::App* forces = AddForcesSubcommand(app, forces_options);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -160,6 +164,7 @@ int Main(int argc, char** argv) {
   try {
     if (*info) return Info();
     if (*check) return Check(scene_path, overrides);
+    if (*forces) return ForcesCommand(forces_options);
     LoadedScene scene = LoadScene(scene_path, overrides);
     RunOptions options;
     options.out_dir = out_dir.empty() ? "results/" + scene.model.name : out_dir;

@@ -13,12 +13,14 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "app/forces_command.h"
 #include "core/log.h"
 #include "grid/sparse_grid.h"
 #include "io/results_writer.h"
@@ -102,6 +104,27 @@ std::vector<std::string> RigidBodyNames(const Model& model) {
     names[body] = ob.name;
   }
   return names;
+}
+
+// <out>/summary.json: the force analysis of the finished result, the same document as
+// `surge forces --json` (docs/results-format.md, "summary.json"); written through a temporary
+// file and a rename, so a reader never sees half of it. A failure is a warning, not a failed run.
+void WriteSummaryJson(const std::string& out_dir, RunSummary& summary) {
+  const std::string path = out_dir + "/summary.json";
+  try {
+    ForcesCommandOptions options;
+    options.result_path = summary.h5_path;
+    const std::string json = ForcesSummaryJson(options, &summary.analysis_lines);
+    const std::string tmp = path + ".tmp";
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw std::runtime_error("cannot create " + tmp);
+    const bool ok = std::fwrite(json.data(), 1, json.size(), f) == json.size();
+    if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + tmp);
+    std::filesystem::rename(tmp, path);
+    summary.summary_json_path = path;
+  } catch (const std::exception& e) {
+    LogWarn(std::string("summary.json not written: ") + e.what());
+  }
 }
 
 }  // namespace
@@ -208,6 +231,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   summary.h5_path = writer.h5_path();
   summary.xmf_path = writer.xmf_path();
   summary.snapshots = writer.snapshot_count();
+  WriteSummaryJson(options.out_dir, summary);
   return summary;
 }
 
@@ -244,8 +268,11 @@ void PrintSummary(const LoadedScene& scene, const RunSummary& s) {
                 bodies[b].c_str(), r.position.x(), r.position.y(), r.position.z(),
                 r.velocity.norm(), r.angular_velocity.norm());
   }
+  for (const std::string& line : s.analysis_lines) std::printf("   %s\n", line.c_str());
   std::printf("   results: %s (%d snapshots)\n            %s (open in ParaView)\n",
               s.h5_path.c_str(), s.snapshots, s.xmf_path.c_str());
+  if (!s.summary_json_path.empty())
+    std::printf("            %s (surge forces --json)\n", s.summary_json_path.c_str());
 }
 
 }  // namespace surge

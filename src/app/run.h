@@ -43,6 +43,10 @@ struct RunSummary {
   std::vector<StructurePeak> force_peaks;  // as force_channels
   std::string h5_path, xmf_path;
   int snapshots = 0;
+  // <out>/summary.json (`surge forces --json` of the result; "" if it could not be written) and
+  // the main numbers of its analysis, as printed.
+  std::string summary_json_path;
+  std::vector<std::string> analysis_lines;
 };
 
 RunSummary RunScene(LoadedScene& scene, const RunOptions& options);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "io/results_reader.h"
 #include "io/results_writer.h"
 #include "io/xdmf.h"
 
@@ -968,5 +969,159 @@ std::string ResultsWriter::rigid_csv_path(const std::string& body) const {
   return (fs::path(impl_->out_dir) / ("rigid_" + body + ".csv")).string();
 }
 const ForceSummary& ResultsWriter::force_summary() const { return impl_->summary; }
+
+// --- Reading the force series back (results_reader.h) --------------------------------------
+
+namespace {
+
+// A string attribute or scalar string dataset: fixed-length (as written here) or variable.
+std::string ReadString(hid_t obj, bool dataset, const std::string& what, const std::string& path) {
+  Handle type(dataset ? H5Dget_type(obj) : H5Aget_type(obj), H5Tclose);
+  Require(type.ok() && H5Tget_class(type.get()) == H5T_STRING, "read string " + what, path);
+  if (H5Tis_variable_str(type.get()) > 0) {
+    Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(mem.get(), H5T_VARIABLE);
+    char* s = nullptr;
+    const herr_t rc = dataset ? H5Dread(obj, mem.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &s)
+                              : H5Aread(obj, mem.get(), &s);
+    Require(rc >= 0, "read string " + what, path);
+    std::string out = s ? s : "";
+    H5free_memory(s);
+    return out;
+  }
+  // Fixed length: read in the stored type itself (UTF-8 to ASCII has no conversion path).
+  const size_t size = H5Tget_size(type.get());
+  std::string out(size, '\0');
+  const herr_t rc = dataset ? H5Dread(obj, type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data())
+                            : H5Aread(obj, type.get(), out.data());
+  Require(rc >= 0, "read string " + what, path);
+  out.resize(std::strlen(out.c_str()));
+  return out;
+}
+
+std::string ReadStringAttr(hid_t obj, const char* name, const std::string& path) {
+  Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  Require(attr.ok(), std::string("open attribute ") + name, path);
+  return ReadString(attr.get(), false, name, path);
+}
+
+std::vector<std::string> SplitNames(const std::string& s) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start < s.size()) {
+    const size_t comma = s.find(',', start);
+    const size_t end = comma == std::string::npos ? s.size() : comma;
+    if (end > start) out.push_back(s.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+// An n (cols = 0) or n x cols float64 dataset, row-major.
+std::vector<double> ReadDoubles(hid_t loc, const std::string& name, size_t cols, size_t& rows,
+                                const std::string& path) {
+  Handle ds(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
+  Require(ds.ok(), "open dataset " + name, path);
+  Handle space(H5Dget_space(ds.get()), H5Sclose);
+  hsize_t dims[2] = {0, 0};
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  if (rank != (cols == 0 ? 1 : 2)) throw IoError("'" + path + "': " + name + " has rank " + std::to_string(rank));
+  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  if (cols != 0 && dims[1] != cols)
+    throw IoError("'" + path + "': " + name + " has " + std::to_string(dims[1]) + " columns, expected " + std::to_string(cols));
+  rows = size_t(dims[0]);
+  std::vector<double> out(rows * std::max<size_t>(cols, 1));
+  if (!out.empty()) {
+    Require(H5Dread(ds.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) >= 0,
+            "read dataset " + name, path);
+  }
+  return out;
+}
+
+std::vector<Real> ReadColumn(hid_t loc, const std::string& name, size_t n, const std::string& path) {
+  size_t rows = 0;
+  std::vector<double> v = ReadDoubles(loc, name, 0, rows, path);
+  if (rows != n) throw IoError("'" + path + "': " + name + " has " + std::to_string(rows) + " rows, time has " + std::to_string(n));
+  return std::vector<Real>(v.begin(), v.end());
+}
+
+std::vector<Vec3> ReadVectors(hid_t loc, const std::string& name, size_t n, const std::string& path) {
+  size_t rows = 0;
+  const std::vector<double> v = ReadDoubles(loc, name, 3, rows, path);
+  if (rows != n) throw IoError("'" + path + "': " + name + " has " + std::to_string(rows) + " rows, time has " + std::to_string(n));
+  std::vector<Vec3> out(n);
+  for (size_t k = 0; k < n; ++k) out[k] = Vec3(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+  return out;
+}
+
+}  // namespace
+
+StoredResult ReadResultForces(const std::string& h5_path) {
+  StoredResult r;
+  r.path = h5_path;
+  std::error_code ec;
+  if (!fs::exists(h5_path, ec)) throw IoError("'" + h5_path + "': no such file");
+  if (!fs::is_regular_file(h5_path, ec)) throw IoError("'" + h5_path + "': not a regular file");
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  if (H5Fis_hdf5(h5_path.c_str()) <= 0)
+    throw IoError("'" + h5_path + "' is not an HDF5 file (expected a Surge result <out>/<name>.h5)");
+  Handle file(H5Fopen(h5_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  Require(file.ok(), "open the file", h5_path);
+  if (H5Lexists(file.get(), "metadata", H5P_DEFAULT) <= 0 ||
+      H5Lexists(file.get(), "metadata/scene", H5P_DEFAULT) <= 0) {
+    throw IoError("'" + h5_path + "' is not a Surge result (no /metadata/scene)");
+  }
+  {
+    Handle ds(H5Dopen2(file.get(), "metadata/scene", H5P_DEFAULT), H5Dclose);
+    Require(ds.ok(), "open /metadata/scene", h5_path);
+    r.scene_text = ReadString(ds.get(), true, "/metadata/scene", h5_path);
+  }
+  if (H5Lexists(file.get(), "metadata/resolved", H5P_DEFAULT) > 0) {
+    Handle ds(H5Dopen2(file.get(), "metadata/resolved", H5P_DEFAULT), H5Dclose);
+    Require(ds.ok(), "open /metadata/resolved", h5_path);
+    r.resolved_yaml = ReadString(ds.get(), true, "/metadata/resolved", h5_path);
+  }
+  if (H5Aexists(file.get(), "name") > 0) r.name = ReadStringAttr(file.get(), "name", h5_path);
+  if (H5Aexists(file.get(), "scene_path") > 0)
+    r.scene_path = ReadStringAttr(file.get(), "scene_path", h5_path);
+  if (H5Aexists(file.get(), "dimension") > 0) {
+    Handle attr(H5Aopen(file.get(), "dimension", H5P_DEFAULT), H5Aclose);
+    int dim = 3;
+    if (attr.ok() && H5Aread(attr.get(), H5T_NATIVE_INT, &dim) >= 0) r.dimension = dim;
+  }
+  if (H5Lexists(file.get(), "timing", H5P_DEFAULT) > 0) {
+    Handle g(H5Gopen2(file.get(), "timing", H5P_DEFAULT), H5Gclose);
+    if (g.ok() && H5Aexists(g.get(), "exit_status") > 0)
+      r.exit_status = ReadStringAttr(g.get(), "exit_status", h5_path);
+  }
+  if (H5Lexists(file.get(), "forces", H5P_DEFAULT) <= 0) return r;
+  Handle forces(H5Gopen2(file.get(), "forces", H5P_DEFAULT), H5Gclose);
+  Require(forces.ok(), "open group /forces", h5_path);
+  for (const std::string& name : SplitNames(ReadStringAttr(forces.get(), "structures", h5_path))) {
+    Handle g(H5Gopen2(forces.get(), name.c_str(), H5P_DEFAULT), H5Gclose);
+    Require(g.ok(), "open group /forces/" + name, h5_path);
+    StoredForceSeries s;
+    s.name = name;
+    size_t n = 0;
+    const std::vector<double> t = ReadDoubles(g.get(), "time", 0, n, h5_path);
+    s.time.assign(t.begin(), t.end());
+    s.dt = ReadColumn(g.get(), "dt", n, h5_path);
+    s.force = ReadVectors(g.get(), "force", n, h5_path);
+    s.contact_area = ReadColumn(g.get(), "contact_area", n, h5_path);
+    s.wetted_height = ReadColumn(g.get(), "wetted_height", n, h5_path);
+    for (const std::string& face : SplitNames(ReadStringAttr(g.get(), "faces", h5_path))) {
+      StoredFaceSeries f;
+      f.name = face;
+      const std::string fp = "faces/" + face;
+      Handle fg(H5Gopen2(g.get(), fp.c_str(), H5P_DEFAULT), H5Gclose);
+      Require(fg.ok(), "open group /forces/" + name + "/" + fp, h5_path);
+      f.force = ReadVectors(fg.get(), "force", n, h5_path);
+      f.contact_area = ReadColumn(fg.get(), "contact_area", n, h5_path);
+      s.faces.push_back(std::move(f));
+    }
+    r.structures.push_back(std::move(s));
+  }
+  return r;
+}
 
 }  // namespace surge
