@@ -1,4 +1,4 @@
-// surge: command-line entry point (CLI11). Subcommands: run, check, info, forces.
+// surge: command-line entry point (CLI11). Subcommands: run, check, info, forces, sweep.
 #include <CLI/CLI.hpp>
 #include <tbb/version.h>
 
@@ -13,6 +13,7 @@
 #include "app/forces_command.h"
 #include "app/run.h"
 #include "app/scene_warnings.h"
+#include "app/sweep_command.h"
 #include "core/log.h"
 #include "grid/sparse_grid.h"
 #include "io/results_writer.h"
@@ -153,6 +154,9 @@ int Main(int argc, char** argv) {
   ForcesCommandOptions forces_options;
   CLI::App* forces = AddForcesSubcommand(app, forces_options);
 
+  SweepCommandOptions sweep_options;
+  CLI::App* sweep = AddSweepSubcommand(app, sweep_options);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -165,6 +169,7 @@ int Main(int argc, char** argv) {
     if (*info) return Info();
     if (*check) return Check(scene_path, overrides);
     if (*forces) return ForcesCommand(forces_options);
+    if (*sweep) return SweepCommand(sweep_options);
     LoadedScene scene = LoadScene(scene_path, overrides);
     RunOptions options;
     options.out_dir = out_dir.empty() ? "results/" + scene.model.name : out_dir;
