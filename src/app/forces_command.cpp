@@ -282,6 +282,9 @@ Json Build(const ForcesCommandOptions& o) {
                          {"r_pk", Number(k.r_pk)},
                          {"r_pk_smoothed", Number(k.r_pk_smoothed)},
                          {"r_ss", Number(k.r_ss)},
+                         {"f_st_hb", Number(k.f_st_hb)},
+                         {"r_pk_hb", Number(k.r_pk_hb)},
+                         {"r_ss_hb", Number(k.r_ss_hb)},
                          {"peak_to_steady", Number(k.peak_to_steady)}};
     std::vector<std::string> all = notes;
     for (const std::string& n : a.notes) all.push_back(n);
@@ -398,20 +401,25 @@ void PrintTable(const Json& j) {
   for (const std::string& line : AnalysisLines(j)) std::printf("%s\n", line.c_str());
   const Json& m = j["analysis"];
   const Json& ref = m["reference"];
-  std::printf("  reference     v0 %s m/s, rho0 %s kg/m^3, w_c %s m, H_b %s m, A %s m^2, K0 %s, |g| %s m/s^2\n",
+  std::printf("  reference     v0 %s m/s, rho0 %s kg/m^3, w_c %s m, H_b %s m, A %s %s, K0 %s, |g| %s m/s^2\n",
               G(ref["velocity"]).c_str(), G(ref["density"]).c_str(), G(ref["width"]).c_str(),
-              G(ref["height"]).c_str(), G(ref["area"]).c_str(), G(ref["k0"]).c_str(),
+              G(ref["height"]).c_str(), G(ref["area"]).c_str(),
+              j["dimension"].get<int>() == 2 ? "m^2/m" : "m^2", G(ref["k0"]).c_str(),
               G(ref["gravity"]).c_str());
   if (!ref["defaults"].get<std::string>().empty())
     std::printf("                (defaults: %s)\n", ref["defaults"].get<std::string>().c_str());
   const Json& k = m["coefficients"];
-  std::printf("  contact       A_act %s m^2 at the peak, %s m^2 steady; A_ratio %s / %s\n",
-              G(m["contact"]["a_act_peak"]).c_str(), G(m["contact"]["a_act_steady"]).c_str(),
+  const std::string area_unit = j["dimension"].get<int>() == 2 ? "m^2/m" : "m^2";
+  std::printf("  contact       A_act %s %s at the peak, %s %s steady; A_ratio %s / %s\n",
+              G(m["contact"]["a_act_peak"]).c_str(), area_unit.c_str(),
+              G(m["contact"]["a_act_steady"]).c_str(), area_unit.c_str(),
               G(k["a_ratio_pk"], "%.4g").c_str(), G(k["a_ratio_ss"], "%.4g").c_str());
   std::printf("  also          C_pk smoothed %s, C_pk/C_ss on A_act %s / %s, R_pk smoothed %s, f_pk/f_ss %s\n",
               G(k["c_pk_smoothed"], "%.4g").c_str(), G(k["c_pk_actual"], "%.4g").c_str(),
               G(k["c_ss_actual"], "%.4g").c_str(), G(k["r_pk_smoothed"], "%.4g").c_str(),
               G(k["peak_to_steady"], "%.4g").c_str());
+  std::printf("  with H_b      f_st %s %s, R_pk %s, R_ss %s\n", G(k["f_st_hb"]).c_str(), unit.c_str(),
+              G(k["r_pk_hb"], "%.4g").c_str(), G(k["r_ss_hb"], "%.4g").c_str());
   if (!m["notes"].get<std::string>().empty())
     std::printf("  notes         %s\n", m["notes"].get<std::string>().c_str());
 }

@@ -397,6 +397,11 @@ Coefficients ComputeCoefficients(Real f_pk, Real f_pk_smoothed, std::optional<Re
       c.f_st_ss = per_h2 * *c.h_act_ss * *c.h_act_ss;
       if (f_ss && *c.f_st_ss > 0) c.r_ss = *f_ss / *c.f_st_ss;  // R_ss (7.19)
     }
+    if (ref.height && *ref.height > 0) {  // (7.17)-(7.18) with H_b for H_act
+      c.f_st_hb = per_h2 * *ref.height * *ref.height;
+      c.r_pk_hb = f_pk / *c.f_st_hb;
+      if (f_ss) c.r_ss_hb = *f_ss / *c.f_st_hb;
+    }
   }
   if (f_ss && *f_ss > 0) c.peak_to_steady = f_pk / *f_ss;
   if (!f_ss) c.notes.push_back("no steady state: C_ss, R_ss omitted");

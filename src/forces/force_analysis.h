@@ -129,6 +129,9 @@ struct Coefficients {
   std::optional<Real> f_st_pk, f_st_ss;          // 1/2 K0 rho0 |g| H_act^2 w_c (7.17-7.18) [N]
   std::optional<Real> r_pk, r_ss;                // f / f_st (7.19) [-]
   std::optional<Real> r_pk_smoothed;             // smoothed peak / f_st_pk [-]
+  // The same with H_b for H_act: f_st of the undisturbed flow depth, independent of the
+  // node-count contact area (which the grid inflates, docs/forces.md) [N], [-].
+  std::optional<Real> f_st_hb, r_pk_hb, r_ss_hb;
   std::optional<Real> peak_to_steady;            // f_pk / f_ss [-]
   std::vector<std::string> notes;
 };

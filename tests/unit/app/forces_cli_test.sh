@@ -104,6 +104,8 @@ assert abs(c["c_pk"] - f_pk / (1000 * 1**2 * 1 * 0.1)) <= 1e-12 * c["c_pk"]  # (
 h_act = area[kk] / 1.0                                                        # (7.15)
 f_st = 0.5 * 0.5 * 1000 * 9.81 * h_act**2 * 1.0                               # (7.17)-(7.18)
 assert abs(c["f_st_pk"] - f_st) <= 1e-12 * f_st and abs(c["r_pk"] - f_pk / f_st) <= 1e-12 * c["r_pk"]
+f_st_hb = 0.5 * 0.5 * 1000 * 9.81 * 0.1**2 * 1.0                              # H_b = 0.1 m
+assert abs(c["f_st_hb"] - f_st_hb) <= 1e-12 * f_st_hb and abs(c["r_pk_hb"] - f_pk / f_st_hb) <= 1e-12 * c["r_pk_hb"]
 ss = a["steady_state"]
 assert ss["status"] in ("found", "none")
 if ss["status"] == "none":

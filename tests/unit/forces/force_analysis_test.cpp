@@ -283,6 +283,10 @@ TEST(ForceAnalysisTest, CoefficientsByHand) {
   EXPECT_EQ(*c.r_pk, 0.6);                     // (7.19)
   EXPECT_DOUBLE_EQ(*c.r_ss, 24000.0 / 90000);
   EXPECT_EQ(*c.peak_to_steady, 4);
+  // With H_b = 3 m for H_act: 1/2 0.5 2000 10 9 2 = 90000 N.
+  EXPECT_EQ(*c.f_st_hb, 90000);
+  EXPECT_DOUBLE_EQ(*c.r_pk_hb, 96000.0 / 90000);
+  EXPECT_DOUBLE_EQ(*c.r_ss_hb, 24000.0 / 90000);
   EXPECT_TRUE(c.notes.empty());
 
   // An explicit area wins over w_c H_b; no velocity: no C, but R still.
@@ -294,6 +298,7 @@ TEST(ForceAnalysisTest, CoefficientsByHand) {
   EXPECT_FALSE(d.c_ss);
   EXPECT_FALSE(d.r_ss);
   EXPECT_EQ(*d.r_pk, 0.6);
+  EXPECT_FALSE(d.r_ss_hb);
   ASSERT_EQ(d.notes.size(), 2u);
   EXPECT_NE(d.notes[0].find("no steady state"), std::string::npos);
   EXPECT_NE(d.notes[1].find("velocity"), std::string::npos) << d.notes[1];
