@@ -8,6 +8,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -255,7 +256,9 @@ class Runner {
     posix_spawnattr_setpgroup(&attr, 0);
     posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
     pid_t pid = -1;
-    const int rc = posix_spawn(&pid, exe_.c_str(), &actions, &attr, argv.data(), environ);
+    // Executes /proc/self/exe (this very binary, even if it was rebuilt or deleted meanwhile);
+    // argv[0] is its path for the logs.
+    const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, &attr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     posix_spawnattr_destroy(&attr);
     if (rc != 0) throw std::runtime_error("cannot start " + exe_ + ": " + std::strerror(rc));
@@ -536,6 +539,15 @@ int SweepCommand(const SweepCommandOptions& o) {
     const bool finished = RunCases(spec, views, todo, 1, 0);
     if (!finished) return kExitInterrupted;
     return views[0].status == "completed" ? kExitOk : kExitFailure;
+  }
+
+  // One sweep at a time per results folder (--case tasks of a job array run side by side and
+  // take no lock: each writes only its own case folder). The lock goes with the process.
+  fs::create_directories(spec.out);
+  const std::string lock_path = (fs::path(spec.out) / "sweep.lock").string();
+  const int lock = open(lock_path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (lock < 0 || flock(lock, LOCK_EX | LOCK_NB) != 0) {
+    throw std::runtime_error("another surge sweep is running in " + spec.out + " (" + lock_path + ")");
   }
 
   std::printf("sweep %s: %d cases, %zu to run (%d completed before), %d at a time x %d thread(s); results in %s\n",

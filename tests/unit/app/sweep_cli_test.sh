@@ -64,6 +64,32 @@ fi
 [ -s "$out/case_002_w=0.2_v=0.5/sweep_tiny_2d.h5" ] && grep -q 'finished\|steps' "$out/case_002_w=0.2_v=0.5/log.txt" \
   && ok case_results_and_log || bad "case_results_and_log: no .h5 or log.txt of case 2"
 
+# surge run writes summary.json; its leaves follow as dotted columns, the same in every row.
+if [ -s "$out/case_000_w=0.1_v=0.5/summary.json" ]; then
+  if /usr/bin/python3 - "$csv" <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+extra = rows[0][7:]
+assert extra and all(c and " " not in c for c in extra), extra[:5]
+assert any("." in c for c in extra), extra[:5]
+assert all(len(r) == len(rows[0]) for r in rows), [len(r) for r in rows]
+assert all(any(cell for cell in r[7:]) for r in rows[1:])
+PY
+  then
+    ok csv_summary_columns
+  else
+    bad "csv_summary_columns: $(head -1 "$csv" | cut -c1-300)"
+  fi
+fi
+
+# Another sweep into the same folder while one runs is refused.
+exec 9>"$out/sweep.lock"
+if flock -n 9; then
+  expect lock_refused 1 'another surge sweep is running' -- "$surge" sweep "$tiny" --out "$out"
+  flock -u 9
+fi
+exec 9>&-
+
 # Rerun: every case is completed, nothing runs again (logs untouched).
 before=$(stat -c %Y.%N "$out"/case_*/log.txt "$out"/case_*/*.h5 | md5sum)
 sleep 1
