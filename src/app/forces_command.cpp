@@ -130,7 +130,9 @@ ForceSignal Signal(const StoredForceSeries& s, int face) {
   return sig;
 }
 
-Json Build(const ForcesCommandOptions& o) {
+// lenient (the end of `surge run`): impossible filter settings drop the detailed analysis with a
+// note instead of failing, so that summary.json is still written.
+Json Build(const ForcesCommandOptions& o, bool lenient) {
   const StoredResult r = ReadResultForces(o.result_path);
   std::vector<std::string> notes;
 
@@ -231,6 +233,8 @@ Json Build(const ForcesCommandOptions& o) {
           (faces.empty() ? std::string("it has no faces") : "faces: " + Join(faces)) + ")");
     }
   }
+  ForceAnalysis a;
+  ForceComponent a_component = ForceComponent::kMagnitude;
   if (target) {
     const std::optional<Vec3> normal = AxisFaceNormal(settings.face);
     ForceComponent component =
@@ -241,8 +245,17 @@ Json Build(const ForcesCommandOptions& o) {
                                   (settings.face.empty() ? std::string()
                                                          : ", got '" + settings.face + "'"));
     }
-    const ForceAnalysis a = AnalyseForce(Signal(*target, face), component,
-                                         normal.value_or(Vec3::UnitX()), settings);
+    a_component = component;
+    try {
+      a = AnalyseForce(Signal(*target, face), component, normal.value_or(Vec3::UnitX()), settings);
+    } catch (const std::invalid_argument& e) {
+      if (!lenient) throw;
+      notes.push_back(std::string("no analysis of '") + target->name + "': " + e.what());
+      target = nullptr;
+    }
+  }
+  if (target) {
+    const ForceComponent component = a_component;
     Json m;
     m["structure"] = target->name;
     m["face"] = settings.face;
@@ -295,19 +308,22 @@ Json Build(const ForcesCommandOptions& o) {
     j["notes"] = Join(notes, "; ");
   }
 
-  // Overview: |F| of every structure and face, with the same smoothing and steady-state settings.
+  // Overview: |F| of every structure and face, with the same steady-state settings (the
+  // smoothing plays no part in it).
+  AnalysisSettings overview = settings;
+  overview.smoothing = SmoothingSettings{};
   Json all = Json::object();
   for (const StoredForceSeries& s : r.structures) {
-    const ForceAnalysis a = AnalyseForce(Signal(s, -1), ForceComponent::kMagnitude,
-                                         Vec3::UnitX(), settings);
-    Json e = OverviewJson(a, settings.steady_state);
+    const ForceAnalysis sa = AnalyseForce(Signal(s, -1), ForceComponent::kMagnitude,
+                                          Vec3::UnitX(), overview);
+    Json e = OverviewJson(sa, settings.steady_state);
     Real wetted = 0;
     for (Real h : s.wetted_height) wetted = std::max(wetted, h);
     e["peak_wetted_height"] = wetted;
     Json faces = Json::object();
     for (size_t f = 0; f < s.faces.size(); ++f) {
       const ForceAnalysis fa = AnalyseForce(Signal(s, int(f)), ForceComponent::kMagnitude,
-                                            Vec3::UnitX(), settings);
+                                            Vec3::UnitX(), overview);
       faces[s.faces[f].name] = OverviewJson(fa, settings.steady_state);
     }
     e["faces"] = faces;
@@ -459,14 +475,14 @@ CLI::App* AddForcesSubcommand(CLI::App& app, ForcesCommandOptions& o) {
 }
 
 std::string ForcesSummaryJson(const ForcesCommandOptions& options, std::vector<std::string>* lines) {
-  const Json j = Build(options);
+  const Json j = Build(options, /*lenient=*/true);
   if (lines) *lines = AnalysisLines(j);
   return j.dump(2) + "\n";
 }
 
 int ForcesCommand(const ForcesCommandOptions& options) {
   try {
-    const Json j = Build(options);
+    const Json j = Build(options, /*lenient=*/false);
     if (options.json) {
       std::printf("%s\n", j.dump(2).c_str());
     } else {

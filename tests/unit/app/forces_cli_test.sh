@@ -133,6 +133,13 @@ expect forces_unknown_face 2 "structure 'wall' has no face 'side' \(faces: x-, x
 expect forces_normal_needs_axis_face 2 "component normal needs an axis face" -- "$surge" forces "$out/fa.h5" --obstacle wall --component normal
 expect forces_bad_smooth 2 "unknown filter 'gauss'" -- "$surge" forces "$out/fa.h5" --smooth gauss=1
 expect forces_nyquist 2 "Nyquist" -- "$surge" forces "$out/fa.h5" --smooth low_pass=1e6
+# Impossible filter settings in the scene: the run still writes summary.json, with a note.
+expect run_lenient_summary 0 'completed' -- "$surge" run "$work/fa.yaml" --out "$work/lenient" --progress quiet --set time.end=0.05 --set "analysis.smoothing={low_pass: 1.0e6}"
+if grep -q '"notes": "no analysis of .wall.: low_pass cut-off' "$work/lenient/summary.json" 2> /dev/null && grep -q '"wall"' "$work/lenient/summary.json"; then
+  echo "ok   run_lenient_summary_json"; pass=$((pass + 1))
+else
+  echo "FAIL run_lenient_summary_json"; head -20 "$work/lenient/summary.json"; fail=$((fail + 1))
+fi
 expect forces_scene_error 2 "analysis.structure" -- "$surge" check "$work/fa.yaml" --set analysis.structure=pier
 echo "forces cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
