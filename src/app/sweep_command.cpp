@@ -542,12 +542,15 @@ int SweepCommand(const SweepCommandOptions& o) {
   }
 
   // One sweep at a time per results folder (--case tasks of a job array run side by side and
-  // take no lock: each writes only its own case folder). The lock goes with the process.
+  // take no lock: each writes only its own case folder). The lock is released when the last
+  // process holding it ends: the sweep and, as the descriptor is inherited (no O_CLOEXEC), its
+  // running cases, so that cases left running by a killed sweep are not started twice.
   fs::create_directories(spec.out);
   const std::string lock_path = (fs::path(spec.out) / "sweep.lock").string();
-  const int lock = open(lock_path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  const int lock = open(lock_path.c_str(), O_WRONLY | O_CREAT, 0644);
   if (lock < 0 || flock(lock, LOCK_EX | LOCK_NB) != 0) {
-    throw std::runtime_error("another surge sweep is running in " + spec.out + " (" + lock_path + ")");
+    throw std::runtime_error("another surge sweep, or cases left running by one that was killed, "
+                             "still run in " + spec.out + " (lock: " + lock_path + ")");
   }
 
   std::printf("sweep %s: %d cases, %zu to run (%d completed before), %d at a time x %d thread(s); results in %s\n",

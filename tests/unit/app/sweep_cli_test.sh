@@ -85,10 +85,24 @@ fi
 # Another sweep into the same folder while one runs is refused.
 exec 9>"$out/sweep.lock"
 if flock -n 9; then
-  expect lock_refused 1 'another surge sweep is running' -- "$surge" sweep "$tiny" --out "$out"
+  expect lock_refused 1 'another surge sweep' -- "$surge" sweep "$tiny" --out "$out"
   flock -u 9
 fi
 exec 9>&-
+
+# A sweep killed hard (SIGKILL) leaves its cases running; they hold the lock until they end.
+cat > "$work/slow.yaml" <<YAML
+base: $src/scenes/two_disks_2d.yaml
+parameters:
+  time.end: [1.5]
+YAML
+"$surge" sweep "$work/slow.yaml" --out "$work/slow" >/dev/null 2>&1 &
+spid=$!
+for _ in $(seq 50); do [ -s "$work/slow/case_000_end=1.5/log.txt" ] && break; sleep 0.1; done
+kill -9 "$spid"; wait "$spid" 2>/dev/null
+expect lock_orphans 1 'cases left running by one that was killed' -- "$surge" sweep "$work/slow.yaml" --out "$work/slow"
+for _ in $(seq 100); do pgrep -f "run $src/scenes/two_disks_2d.yaml --out $work/slow" >/dev/null || break; sleep 0.1; done
+expect lock_released 0 '1 cases, 0 to run \(1 completed before\)' -- "$surge" sweep "$work/slow.yaml" --out "$work/slow"
 
 # Rerun: every case is completed, nothing runs again (logs untouched).
 before=$(stat -c %Y.%N "$out"/case_*/log.txt "$out"/case_*/*.h5 | md5sum)
