@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -90,10 +91,31 @@ std::vector<std::string> OverrideTexts(const SweepCase& c) {
   return texts;
 }
 
+// What validating a case tells about it.
+struct CaseScene {
+  std::string h5_name;  // "<scene name>.h5"
+  std::string digest;   // SceneDigest of the case's resolved scene
+};
+
+// FNV-1a (64 bit) of the resolved scene (every key, defaults filled in, after the overrides and
+// expressions), in hex: a case whose scene changed since it ran is outdated. Comments and
+// layout of the scene file do not count; mesh file contents do not either.
+std::string SceneDigest(const std::string& resolved_yaml) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : resolved_yaml) {
+    h ^= ch;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
 // Everything known about one case: its folder, how it last ran, its summary.
 struct CaseView {
   const SweepCase* c = nullptr;
   std::string dir;         // <out>/<case name>
+  std::string digest;      // of the scene it will run (validated); "" when not validated
   std::string h5;          // results file; "" until known
   std::string status;      // completed, failed, unhealthy, interrupted, incomplete, outdated, not_run
   int exit_code = -1;
@@ -101,15 +123,16 @@ struct CaseView {
   std::string detail;      // why it is not completed
 };
 
-// Reads the state of case `c` from its folder. `h5_name` is "<scene name>.h5" when the case
-// was validated, else "" (taken from the case record or the folder's only .h5).
-CaseView InspectCase(const SweepSpec& spec, const SweepCase& c, const std::string& h5_name) {
+// Reads the state of case `c` from its folder. `known` comes from validating the case; without
+// it (--collect) the results file is the folder's only .h5 and the scene is not compared.
+CaseView InspectCase(const SweepSpec& spec, const SweepCase& c, const CaseScene& known) {
   CaseView v;
   v.c = &c;
   v.dir = (fs::path(spec.out) / c.name).string();
+  v.digest = known.digest;
   SweepCaseRecord record;
   const bool has_record = ReadSweepCaseRecord((fs::path(v.dir) / "case.yaml").string(), record);
-  std::string name = h5_name;
+  std::string name = known.h5_name;
   std::error_code ec;
   if (name.empty() && fs::is_directory(v.dir, ec)) {
     for (const auto& e : fs::directory_iterator(v.dir, ec)) {
@@ -123,6 +146,11 @@ CaseView InspectCase(const SweepSpec& spec, const SweepCase& c, const std::strin
   if (has_record && record.overrides != OverrideTexts(c)) {
     v.status = "outdated";
     v.detail = "ran with other overrides: " + std::to_string(record.overrides.size()) + " --set";
+    return v;
+  }
+  if (has_record && !v.digest.empty() && !record.scene_digest.empty() && record.scene_digest != v.digest) {
+    v.status = "outdated";
+    v.detail = "the base scene changed since it ran";
     return v;
   }
   v.wall_seconds = has_record ? record.wall_seconds : rs.wall_seconds;
@@ -189,13 +217,13 @@ std::string WriteCsv(const SweepSpec& spec, const std::vector<CaseView>& views) 
 }
 
 // Loads every case's scene with its overrides (seeding included), so that a bad value fails
-// before anything runs. Returns "<scene name>.h5" per case.
-std::vector<std::string> ValidateCases(const SweepSpec& spec, const std::vector<const SweepCase*>& cases) {
-  std::vector<std::string> h5_names;
+// before anything runs.
+std::vector<CaseScene> ValidateCases(const SweepSpec& spec, const std::vector<const SweepCase*>& cases) {
+  std::vector<CaseScene> scenes;
   for (const SweepCase* c : cases) {
     try {
       const LoadedScene scene = LoadScene(spec.base, OverrideTexts(*c));
-      h5_names.push_back(scene.model.name + ".h5");
+      scenes.push_back({scene.model.name + ".h5", SceneDigest(scene.resolved_yaml)});
     } catch (const SceneError& e) {
       // Point at the sweep file's value when an override is to blame.
       int line = 0, column = 0;
@@ -205,7 +233,7 @@ std::vector<std::string> ValidateCases(const SweepSpec& spec, const std::vector<
       throw SceneError(spec.path, line, column, "", "case " + c->name + ": " + e.what());
     }
   }
-  return h5_names;
+  return scenes;
 }
 
 class Runner {
@@ -222,6 +250,7 @@ class Runner {
     record.index = v.c->index;
     record.scene = spec_.base;
     record.overrides = OverrideTexts(*v.c);
+    record.scene_digest = v.digest;
     record.status = "running";
     WriteSweepCaseRecord((fs::path(v.dir) / "case.yaml").string(), record);
 
@@ -275,12 +304,13 @@ class Runner {
     record.index = v.c->index;
     record.scene = spec_.base;
     record.overrides = OverrideTexts(*v.c);
+    record.scene_digest = v.digest;
     record.exit_code = code;
     record.wall_seconds = wall_seconds;
     record.status = code == kExitOk ? "completed" : "ended";
     WriteSweepCaseRecord((fs::path(v.dir) / "case.yaml").string(), record);
-    const std::string h5_name = v.h5.empty() ? "" : fs::path(v.h5).filename().string();
-    v = InspectCase(spec_, *v.c, h5_name);
+    const CaseScene known{v.h5.empty() ? "" : fs::path(v.h5).filename().string(), v.digest};
+    v = InspectCase(spec_, *v.c, known);
   }
 
  private:
@@ -470,7 +500,7 @@ int SweepCommand(const SweepCommandOptions& o) {
 
   if (o.collect) {
     std::vector<CaseView> views;
-    for (const SweepCase& c : spec.cases) views.push_back(InspectCase(spec, c, ""));
+    for (const SweepCase& c : spec.cases) views.push_back(InspectCase(spec, c, CaseScene{}));
     return Summarise(views, WriteCsv(spec, views));
   }
 
@@ -485,9 +515,9 @@ int SweepCommand(const SweepCommandOptions& o) {
   } else {
     for (const SweepCase& c : spec.cases) selected.push_back(&c);
   }
-  const std::vector<std::string> h5_names = ValidateCases(spec, selected);
+  const std::vector<CaseScene> scenes = ValidateCases(spec, selected);
   std::vector<CaseView> views;
-  for (size_t i = 0; i < selected.size(); ++i) views.push_back(InspectCase(spec, *selected[i], h5_names[i]));
+  for (size_t i = 0; i < selected.size(); ++i) views.push_back(InspectCase(spec, *selected[i], scenes[i]));
 
   if (!o.slurm_path.empty()) {
     const std::string exe = ExePath();

@@ -398,6 +398,7 @@ void WriteSweepCaseRecord(const std::string& path, const SweepCaseRecord& r) {
   e << YAML::Key << "overrides" << YAML::Value << YAML::BeginSeq;
   for (const std::string& o : r.overrides) e << YAML::DoubleQuoted << o;
   e << YAML::EndSeq;
+  e << YAML::Key << "scene_digest" << YAML::Value << r.scene_digest;
   e << YAML::Key << "status" << YAML::Value << r.status;
   e << YAML::Key << "exit_code" << YAML::Value << r.exit_code;
   e << YAML::Key << "wall_seconds" << YAML::Value << r.wall_seconds;
@@ -425,6 +426,7 @@ bool ReadSweepCaseRecord(const std::string& path, SweepCaseRecord& r) {
     r.scene = n["scene"].as<std::string>("");
     r.overrides.clear();
     for (const auto& o : n["overrides"]) r.overrides.push_back(o.as<std::string>());
+    r.scene_digest = n["scene_digest"] ? n["scene_digest"].as<std::string>("") : "";
     r.status = n["status"].as<std::string>("");
     r.exit_code = n["exit_code"].as<int>(-1);
     r.wall_seconds = n["wall_seconds"].as<double>(0);

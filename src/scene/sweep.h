@@ -55,6 +55,7 @@ struct SweepCaseRecord {
   int index = 0;
   std::string scene;                   // the base scene path the case ran
   std::vector<std::string> overrides;  // the --set texts, in order
+  std::string scene_digest;            // of the resolved scene it ran ("" = unknown)
   std::string status;                  // "running", "completed", "failed", ...
   int exit_code = -1;                  // of `surge run`; -1 while running
   double wall_seconds = 0;             // measured by the sweep [s]

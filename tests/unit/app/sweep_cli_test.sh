@@ -150,5 +150,14 @@ expect failing_case_rerun 1 '3 cases, 1 to run \(2 completed before\)' -- "$surg
 sed -i 's/time.end: 0.005/time.end: 0.004/' "$work/mixed.yaml"
 expect outdated_rerun 1 '3 cases, 3 to run \(0 completed before\)' -- "$surge" sweep "$work/mixed.yaml" --out "$work/mixed" --jobs 3
 
+# A case is outdated when its resolved scene changed, not when only a comment did.
+cp "$src/tests/data/scenes/sweep_tiny_2d.yaml" "$work/own.yaml"
+printf 'base: own.yaml\nparameters: {v: [1]}\nset: {time.end: 0.004}\n' > "$work/own_sweep.yaml"
+expect own_first 0 '1 cases, 1 to run' -- "$surge" sweep "$work/own_sweep.yaml" --out "$work/own"
+echo "# a comment" >> "$work/own.yaml"
+expect own_comment 0 '1 cases, 0 to run \(1 completed before\)' -- "$surge" sweep "$work/own_sweep.yaml" --out "$work/own"
+sed -i 's/density: 1000/density: 1100/' "$work/own.yaml"
+expect own_changed 0 'case_000_v=1 \[outdated\]' -- "$surge" sweep "$work/own_sweep.yaml" --out "$work/own" --dry-run
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

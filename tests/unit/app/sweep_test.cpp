@@ -159,6 +159,7 @@ TEST(SweepFile, CaseRecordRoundTrips) {
   r.index = 1;
   r.scene = "/a/b.yaml";
   r.overrides = {"parameters.w=2", "bodies.0.velocity=[1, \"x\"]", "a.b=${3 - w/2}"};
+  r.scene_digest = "00ff00ff00ff00ff";
   r.status = "completed";
   r.exit_code = 0;
   r.wall_seconds = 1.25;
@@ -169,6 +170,7 @@ TEST(SweepFile, CaseRecordRoundTrips) {
   EXPECT_EQ(back.name, r.name);
   EXPECT_EQ(back.index, 1);
   EXPECT_EQ(back.overrides, r.overrides);
+  EXPECT_EQ(back.scene_digest, r.scene_digest);
   EXPECT_EQ(back.exit_code, 0);
   EXPECT_EQ(back.wall_seconds, 1.25);
   EXPECT_FALSE(ReadSweepCaseRecord((dir / "none.yaml").string(), back));
