@@ -59,6 +59,19 @@ struct BodyInfo {
   int material = 0;
 };
 
+// Frictional contact between two MPM bodies (scene key `body_contact`): each body listed in a
+// pair moves with its own velocity field on the shared grid where bodies meet (Bardenhagen et
+// al. 2000; Anura3D manual §6.2). Bodies in no pair share one field (single-field MPM: bonded).
+inline constexpr int kMaxVelocityFields = 16;  // per-body velocity fields at most
+struct BodyContact {
+  int body_a = 0, body_b = 0;  // indices into Model::bodies, body_a < body_b
+  int normal_body = 0;         // body_a or body_b: the body whose surface gives the normal
+  Real friction = 0;           // Coulomb coefficient mu [-]
+  bool separable = true;       // false: the bodies never separate (normal velocity bonded)
+  std::string name;            // force-log channel: "<other>_on_<normal body>", the force on the
+                               // normal body (listed first in the scene) from the other
+};
+
 struct OutputPlan {
   Real every = 0;          // particle snapshot interval [s]; 0 = first and last only
   bool vdb = false;        // also write grid fields (mass, velocity) as .vdb per snapshot
@@ -85,6 +98,11 @@ struct Model {
   std::vector<BodyInfo> bodies;
   std::vector<Obstacle> obstacles;       // rigid structures (src/contact), in scene order
   std::vector<Sensor> sensors;           // force sensors (src/contact), in scene order
+  std::vector<BodyContact> body_contacts;  // MPM-MPM contact pairs; empty = one velocity field
+  // Velocity field of each body (index as bodies) when body_contacts is not empty: the bodies
+  // named in a pair get fields 0, 1, ... in body order, all others share the last field.
+  std::vector<int> body_field;
+  int field_count = 0;                   // number of velocity fields; 0 = single-field MPM
   OutputPlan output;
   AnalysisSettings analysis;  // force analysis, defaults filled in (scene `analysis`, issue #6)
 };

@@ -11,6 +11,7 @@ enum class Stage : int {
   kParticleToGrid,
   kGridUpdate,
   kObstacleContact,    // only with obstacles (src/contact)
+  kBodyContact,        // only with body contacts: per-body velocity fields (src/transfer)
   kGridToParticle,
   kRemapMomentum,      // MUSL only
   kVelocityGradient,   // MUSL only

@@ -52,6 +52,15 @@ struct SparseGrid {
   std::vector<Vec3> reaction;       // force on the structures (walls, obstacles) at the node,
                                     // m (v_u - v_c) / dt, this step [N]   (spec §5.3);
                                     // written only when the scene has force sensors
+  // --- Per-body velocity fields (Model::field_count > 0 only; else empty), [f * nodes + i]. ---
+  int field_count = 0;
+  std::vector<Real> field_mass;          // m_i,f [kg]                      (2.12) per field
+  std::vector<Vec3> field_momentum;      // p_i,f [kg m/s]
+  std::vector<Vec3> field_force;         // f_i,f [N]
+  std::vector<Vec3> field_mass_moment;   // sum_p m_p N_ip (x_p - x_i) [kg m]: m_i,f times the offset
+                                         // of the field's local centre of mass from the node
+  std::vector<Vec3> field_velocity;      // v_i,f at t_n [m/s] (FLIP)
+  std::vector<Vec3> field_velocity_new;  // v_i,f at t_{n+1} after contact and walls [m/s]
 
   // --- Scratch reused by RebuildGrid (no allocation per step after warm-up). ---
   std::vector<Vec3i> particle_block_coord;

@@ -316,6 +316,31 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
   for (size_t o = 0; o < spec.obstacles.size(); ++o) model.obstacles.push_back(BuildObstacle(spec, o));
   for (const SensorSpec& s : spec.sensors) model.sensors.push_back(Sensor{s.name, s.min, s.max});
+  // Body contacts: the bodies named in a pair get a velocity field each (in body order), all
+  // other bodies share one more field (bonded to everything, as in single-field MPM).
+  if (!spec.body_contacts.empty()) {
+    std::vector<bool> paired(spec.bodies.size(), false);
+    for (const BodyContactSpec& c : spec.body_contacts) {
+      const int a = std::min(c.body_index[0], c.body_index[1]);
+      const int b = std::max(c.body_index[0], c.body_index[1]);
+      model.body_contacts.push_back(BodyContact{a, b, c.body_index[0], c.friction, c.separable,
+                                                c.bodies[1] + "_on_" + c.bodies[0]});
+      paired[a] = paired[b] = true;
+    }
+    int fields = 0;
+    model.body_field.assign(spec.bodies.size(), -1);
+    for (size_t b = 0; b < spec.bodies.size(); ++b)
+      if (paired[b]) model.body_field[b] = fields++;
+    const bool rest = std::find(paired.begin(), paired.end(), false) != paired.end();
+    for (size_t b = 0; b < spec.bodies.size(); ++b)
+      if (!paired[b]) model.body_field[b] = fields;
+    model.field_count = fields + (rest ? 1 : 0);
+    if (model.field_count > kMaxVelocityFields) {
+      Fail(spec.body_contacts.front().loc, "body_contact",
+           "the body pairs need " + std::to_string(model.field_count) +
+               " velocity fields; at most " + std::to_string(kMaxVelocityFields) + " are supported");
+    }
+  }
   model.output.every = spec.output.every;
   model.output.vdb = spec.output.vdb;
   model.output.energy = spec.output.energy;

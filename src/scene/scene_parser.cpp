@@ -1093,7 +1093,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
   SceneSpec spec;
   const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
                                         "grid",   "domain",    "materials", "bodies",  "obstacles",
-                                        "sensors", "output", "analysis", "parameters"};
+                                        "sensors", "body_contact", "output", "analysis", "parameters"};
   if (!root.IsDefined() || root.IsNull()) {
     throw SceneError(source_, 0, 0, "", "the scene is empty (expected a map with keys " + Join(top) + ")");
   }
@@ -1231,6 +1231,61 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
                  "' is taken (by 'domain', an obstacle or another sensor: they share the force log)");
       }
       spec.sensors.push_back(std::move(sensor));
+    }
+  }
+
+  if (root["body_contact"]) {
+    const YAML::Node cs = root["body_contact"];
+    if (!cs.IsSequence()) {
+      Fail(cs, "body_contact", "expected a list of body pairs, got " + Describe(cs));
+    }
+    for (size_t i = 0; i < cs.size(); ++i) {
+      const std::string cp = Index("body_contact", i);
+      ExpectMap(cs[i], cp, {"bodies", "friction", "separable"});
+      BodyContactSpec c;
+      c.loc = Loc(cs[i], cp);
+      const YAML::Node names = Need(cs[i], cp, "bodies");
+      const std::string np = Child(cp, "bodies");
+      if (!names.IsSequence() || names.size() != 2) {
+        Fail(names, np, "expected two body names, e.g. [debris, wall], got " + Describe(names));
+      }
+      for (int k = 0; k < 2; ++k) {
+        c.bodies[k] = Identifier(names[k], Index(np, k));
+        int found = -1;
+        std::vector<std::string> valid;
+        for (size_t b = 0; b < spec.bodies.size(); ++b) {
+          valid.push_back(spec.bodies[b].name);
+          if (spec.bodies[b].name == c.bodies[k]) found = int(b);
+        }
+        if (found < 0) {
+          Fail(names[k], Index(np, k), "no body is called '" + c.bodies[k] + "' (bodies: " + Join(valid) + ")");
+        }
+        c.body_index[k] = found;
+      }
+      if (c.body_index[0] == c.body_index[1]) {
+        Fail(names, np, "a body cannot be in contact with itself ('" + c.bodies[0] + "')");
+      }
+      for (const BodyContactSpec& o : spec.body_contacts) {
+        if (std::min(o.body_index[0], o.body_index[1]) == std::min(c.body_index[0], c.body_index[1]) &&
+            std::max(o.body_index[0], o.body_index[1]) == std::max(c.body_index[0], c.body_index[1])) {
+          Fail(names, np, "the pair '" + c.bodies[0] + "', '" + c.bodies[1] + "' is listed twice");
+        }
+      }
+      if (cs[i]["friction"]) c.friction = NonNegative(cs[i]["friction"], Child(cp, "friction"), "-");
+      if (cs[i]["separable"]) c.separable = Bool(cs[i]["separable"], Child(cp, "separable"));
+      // The pair's force-log channel shares one namespace with the other structures.
+      const std::string channel = c.bodies[1] + "_on_" + c.bodies[0];
+      std::vector<std::string> taken = {"domain"};
+      for (const ObstacleSpec& o : spec.obstacles) taken.push_back(o.name);
+      for (const SensorSpec& o : spec.sensors) taken.push_back(o.name);
+      if (std::find(taken.begin(), taken.end(), channel) != taken.end()) {
+        Fail(names, np, "the force log of this pair, '" + channel +
+                            "', would have the name of an obstacle or sensor; rename one");
+      }
+      if (spec.grid.update == UpdateScheme::kMusl) {
+        Fail(cs[i], cp, "body contact needs grid.update: usl (the MUSL re-map of per-body fields is not implemented)");
+      }
+      spec.body_contacts.push_back(std::move(c));
     }
   }
 
@@ -1553,6 +1608,17 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
       e << YAML::Key << "max" << YAML::Value;
       EmitVector(e, s.max, dim);
       e << YAML::EndMap << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+  }
+
+  if (!spec.body_contacts.empty()) {
+    e << YAML::Key << "body_contact" << YAML::Value << YAML::BeginSeq;
+    for (const BodyContactSpec& c : spec.body_contacts) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "bodies" << YAML::Value << YAML::Flow
+        << YAML::BeginSeq << c.bodies[0] << c.bodies[1] << YAML::EndSeq << YAML::Key << "friction"
+        << YAML::Value << Num(c.friction) << YAML::Key << "separable" << YAML::Value << c.separable
+        << YAML::EndMap;
     }
     e << YAML::EndSeq;
   }

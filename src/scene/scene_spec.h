@@ -218,6 +218,14 @@ struct SensorSpec {  // a force sensor box (contact/obstacle.h Sensor)
   SourceLoc loc;
 };
 
+struct BodyContactSpec {  // a pair of bodies in frictional contact (core/model.h BodyContact)
+  std::array<std::string, 2> bodies;
+  std::array<int, 2> body_index{};  // into SceneSpec::bodies
+  Real friction = 0;                // [-]
+  bool separable = true;
+  SourceLoc loc;
+};
+
 struct OutputSpec {
   Real every = 0;  // [s]; 0 = first and last only
   bool vdb = false;
@@ -245,6 +253,7 @@ struct SceneSpec {
   std::vector<BodySpec> bodies;
   std::vector<ObstacleSpec> obstacles;  // in file order; Model::obstacles has the same order
   std::vector<SensorSpec> sensors;      // in file order; Model::sensors has the same order
+  std::vector<BodyContactSpec> body_contacts;  // in file order (Model::body_contacts)
   OutputSpec output;
   AnalysisSpec analysis;
   // `parameters:` in file order, after --set overrides; `${expr}` values were evaluated over

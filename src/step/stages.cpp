@@ -32,6 +32,11 @@ void ObstacleContactStage(const Model& m, const StepContext& c, State& s, Worksp
   ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, &r.obstacles);
 }
 
+void BodyContactStage(const Model& m, const StepContext& c, State&, Workspace& w,
+                      StepReport& r) {
+  ApplyBodyContact(m, c, w.grid, r.walls, r.body_contact);
+}
+
 void SensorsStage(const Model& m, const StepContext& c, State&, Workspace& w, StepReport& r) {
   SumSensors(m, c, w.grid, w.contact, r.sensors);
 }
@@ -102,12 +107,14 @@ std::vector<ForceChannel> ForceChannels(const Model& m) {
   }
   for (const Obstacle& o : m.obstacles) channels.push_back({o.name, o.faces});
   for (const Sensor& s : m.sensors) channels.push_back({s.name, {}});
+  for (const BodyContact& c : m.body_contacts) channels.push_back({c.name, {}});
   return channels;
 }
 
 void CollectForces(const Model& m, const StepReport& step, ContactReport& out) {
   const std::vector<int> walled = WalledFaces(m);
-  out.structures.resize((walled.empty() ? 0 : 1) + m.obstacles.size() + m.sensors.size());
+  out.structures.resize((walled.empty() ? 0 : 1) + m.obstacles.size() + m.sensors.size() +
+                        m.body_contacts.size());
   size_t k = 0;
   if (!walled.empty()) {
     ObstacleForce& d = out.structures[k++];
@@ -142,6 +149,9 @@ void CollectForces(const Model& m, const StepReport& step, ContactReport& out) {
   }
   for (size_t s = 0; s < m.sensors.size(); ++s) {
     out.structures[k++] = s < step.sensors.size() ? step.sensors[s] : ObstacleForce{};
+  }
+  for (size_t c = 0; c < m.body_contacts.size(); ++c) {
+    out.structures[k++] = c < step.body_contact.pairs.size() ? step.body_contact.pairs[c] : ObstacleForce{};
   }
 }
 

@@ -14,6 +14,7 @@ void ParticleToGridStage(const Model&, const StepContext&, State&, Workspace&, S
 void GridUpdateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Node contact with the rigid obstacles on v_{n+1} (src/contact), reactions into the report.
 void ObstacleContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void BodyContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Dynamic obstacles: the step's MPM reaction (force on the structure, torque about the centre of
 // mass) plus the ramped weight act on each Bullet body for dt, then State::rigid takes the new
 // poses and velocities (src/rigid; DESIGN §4 step 6).

@@ -8,6 +8,8 @@
 //   AntiLocking (Mast 2013 Table 4.1) runs just before UpdateStress when a material asks for it.
 //   With obstacles: ObstacleContact after GridUpdate (node contact, reactions) and
 //   ObstacleProjection after the positions are committed (particles back onto the surface).
+//   With body contacts: BodyContact after the grid update and obstacles (per-body velocity
+//   fields), and G2P reads each particle's own field.
 #include "step/step.h"
 
 #include <algorithm>
@@ -30,6 +32,7 @@ Pipeline MakePipeline(const Model& model) {
   p.push_back({Stage::kGridUpdate, GridUpdateStage});                          // (2.13)-(2.14)
   const bool obstacles = !model.obstacles.empty();
   if (obstacles) p.push_back({Stage::kObstacleContact, ObstacleContactStage});  // spec §5.3
+  if (model.field_count > 0) p.push_back({Stage::kBodyContact, BodyContactStage});  // Anura3D §6.2
   const bool antilocking = AnyAntiLocking(model);
   if (model.scheme == UpdateScheme::kUsl) {
     p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)

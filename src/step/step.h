@@ -21,6 +21,7 @@ struct StepReport {
   WallReport walls;              // wall reactions of the last step
   std::vector<ObstacleForce> obstacles;  // obstacle reactions of the last step (Model order)
   std::vector<ObstacleForce> sensors;    // force-sensor sums of the last step (Model order)
+  BodyContactReport body_contact;        // MPM-MPM contact of the last step (body contacts only)
   int64_t removed_last_step = 0; // particles removed through open sides in the last step
 };
 

@@ -20,20 +20,38 @@ struct NodeV01 {
   Real v0[3];  // v_{i,n}
 };
 
+// Fills halo[0 .. Pad::kSize) from the node velocities v_new (v_{n+1}) and v_old (v_n).
 template <int kDim, class K, class Node>
-void GatherHalo(const SparseGrid& grid, size_t blk, std::vector<Node>& halo) {
+void GatherHalo(const SparseGrid& grid, size_t blk, const Vec3* v_new, const Vec3* v_old,
+                Node* halo) {
   using Pad = BlockPad<kDim, K>;
-  halo.resize(Pad::kSize);
   for (int a = 0; a < Pad::E; ++a)
     for (int b = 0; b < Pad::E; ++b)
       for (int c = 0; c < Pad::Ez; ++c) {
         const long g = PaddedToGrid(grid, blk, a, b, c);
         Node& n = halo[Pad::Index(a, b, c)];
         for (int d = 0; d < 3; ++d) {
-          n.v1[d] = g < 0 ? 0.0 : grid.velocity_new[g][d];
-          if constexpr (std::is_same_v<Node, NodeV01>) n.v0[d] = g < 0 ? 0.0 : grid.velocity[g][d];
+          n.v1[d] = g < 0 ? 0.0 : v_new[g][d];
+          if constexpr (std::is_same_v<Node, NodeV01>) n.v0[d] = g < 0 ? 0.0 : v_old[g][d];
         }
       }
+}
+
+// The common field's halo, or with body contacts one halo per velocity field (a particle reads
+// the field of its body: Anura3D manual §6.2, each body is updated from its own field).
+template <int kDim, class K, class Node>
+void GatherHalos(const SparseGrid& grid, size_t blk, std::vector<Node>& halo) {
+  using Pad = BlockPad<kDim, K>;
+  if (grid.field_count == 0) {
+    halo.resize(Pad::kSize);
+    GatherHalo<kDim, K>(grid, blk, grid.velocity_new.data(), grid.velocity.data(), halo.data());
+    return;
+  }
+  const size_t nodes = grid.mass.size();
+  halo.resize(size_t(grid.field_count) * Pad::kSize);
+  for (int f = 0; f < grid.field_count; ++f)
+    GatherHalo<kDim, K>(grid, blk, grid.field_velocity_new.data() + f * nodes,
+                        grid.field_velocity.data() + f * nodes, halo.data() + f * Pad::kSize);
 }
 
 enum class G2PMode { kFlip, kPicFlip, kApic };
@@ -46,10 +64,12 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
   ParallelFor(grid.block_count(), 1, [&](size_t blk) {
     using Node = std::conditional_t<kMode == G2PMode::kApic, NodeV1, NodeV01>;
     thread_local std::vector<Node> halo;
-    GatherHalo<kDim, K>(grid, blk, halo);
+    GatherHalos<kDim, K>(grid, blk, halo);
     const Vec3i origin = grid.block_origin[blk];
     for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
       const uint32_t p = grid.sorted[s];
+      const Node* field_halo = halo.data();
+      if (grid.field_count > 0) field_halo += size_t(model.body_field[P.body[p]]) * Pad::kSize;
       const Vec3 x = P.x[p];
       Stencil<kDim, K> st;
       st.Compute(x, ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
@@ -68,7 +88,7 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
           const Real wxy = st.w[0][i] * st.w[1][j];
           const Real gxy_x = st.g[0][i] * st.w[1][j];
           const Real gxy_y = st.w[0][i] * st.g[1][j];
-          const Node* row = &halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
+          const Node* row = &field_halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
           for (int k = 0; k < st.Wz; ++k) {
             const Real w = wxy * st.w[2][k];
             const Real* v1 = row[k].v1;
@@ -133,7 +153,8 @@ void GradientBlocks(const StepContext& ctx, const SparseGrid& grid, const Partic
   using Pad = BlockPad<kDim, K>;
   ParallelFor(grid.block_count(), 1, [&](size_t blk) {
     thread_local std::vector<NodeV1> halo;
-    GatherHalo<kDim, K>(grid, blk, halo);
+    halo.resize(Pad::kSize);  // MUSL: single field only (the scene builder refuses body contacts)
+    GatherHalo<kDim, K>(grid, blk, grid.velocity_new.data(), grid.velocity.data(), halo.data());
     const Vec3i origin = grid.block_origin[blk];
     for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
       const uint32_t p = grid.sorted[s];

@@ -1,6 +1,8 @@
 // P2G (Mast 2013 eq. (2.12)): mass, momentum (+ APIC affine term), internal and traction forces.
 // Blocks are processed colour by colour; a block accumulates its particles into a padded local
 // buffer and adds it into itself and its 7 upper neighbours (no atomics, fixed summation order).
+#include <type_traits>
+
 #include "core/check.h"
 #include "core/parallel.h"
 #include "transfer/dispatch.h"
@@ -13,17 +15,57 @@ namespace {
 struct NodeAccum {
   Real m, px, py, pz, fx, fy, fz, pad;
 };
+// With per-body velocity fields: also the first mass moment sum_p m_p N_ip (x_p - x_i).
+struct FieldAccum {
+  Real m, px, py, pz, fx, fy, fz, gx, gy, gz;  // g: first mass moment
+};
 
-// kFull: mass, momentum and force; otherwise momentum only (MUSL re-map).
-template <int kDim, class K, bool kApic, bool kFull>
+// Adds a block's per-field padded sums into the field arrays and, field by field in a fixed
+// order, into the common field.
+template <class Pad>
+void FlushFields(SparseGrid& grid, size_t blk, const std::vector<FieldAccum>& buf) {
+  const size_t nodes = grid.mass.size();
+  for (int f = 0; f < grid.field_count; ++f) {
+    const FieldAccum* fb = buf.data() + size_t(f) * Pad::kSize;
+    for (int a = 0; a < Pad::E; ++a)
+      for (int b = 0; b < Pad::E; ++b)
+        for (int c = 0; c < Pad::Ez; ++c) {
+          const FieldAccum& n = fb[Pad::Index(a, b, c)];
+          if (n.m == 0) continue;  // a field's particles give every node of their stencil mass
+          const long g = PaddedToGrid(grid, blk, a, b, c);
+          SURGE_ASSERT(g >= 0);
+          if (g < 0) continue;
+          const size_t gf = size_t(f) * nodes + size_t(g);
+          const Vec3 p(n.px, n.py, n.pz), force(n.fx, n.fy, n.fz);
+          grid.field_mass[gf] += n.m;
+          grid.field_momentum[gf] += p;
+          grid.field_force[gf] += force;
+          grid.field_mass_moment[gf] += Vec3(n.gx, n.gy, n.gz);
+          grid.mass[g] += n.m;
+          grid.momentum[g] += p;
+          grid.force[g] += force;
+        }
+  }
+}
+
+// kFull: mass, momentum and force; otherwise momentum only (MUSL re-map). kFields: one padded
+// buffer per velocity field (body_field maps a particle's body to its field), written to the
+// grid's field arrays and summed into the common field (Anura3D manual (6.1)-(6.3): the common
+// field is the sum of the body fields).
+template <int kDim, class K, bool kApic, bool kFull, bool kFields = false>
 void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, size_t blk,
-                  std::vector<NodeAccum>& buf) {
+                  std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>>& buf,
+                  const int* body_field = nullptr) {
   using Pad = BlockPad<kDim, K>;
-  buf.assign(Pad::kSize, NodeAccum{});
+  using Accum = std::conditional_t<kFields, FieldAccum, NodeAccum>;
+  const int fields = kFields ? grid.field_count : 1;
+  buf.assign(size_t(fields) * Pad::kSize, Accum{});
   const Vec3i origin = grid.block_origin[blk];
   const Real dx = ctx.dx;
   for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
     const uint32_t p = grid.sorted[s];
+    Accum* field_buf = buf.data();
+    if constexpr (kFields) field_buf += size_t(body_field[P.body[p]]) * Pad::kSize;
     const Vec3& x = P.x[p];
     Stencil<kDim, K> st;
     st.Compute(x, ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
@@ -61,10 +103,10 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
             fb[r] = wxy * neg_vs(r, 2);
           }
         }
-        NodeAccum* row = &buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
+        Accum* row = &field_buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
         for (int k = 0; k < st.Wz; ++k) {
           const Real w = wxy * st.w[2][k];
-          NodeAccum& a = row[k];
+          Accum& a = row[k];
           if constexpr (kApic) {
             // APIC: m_p (v_p + C_p (x_i - x_p)) (Jiang et al. 2015, eq. (9)).
             const Real oz = off[2][k];
@@ -84,47 +126,61 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
             a.fy += w2 * fa[1] + g2 * fb[1] + w * fext.y();
             a.fz += w2 * fa[2] + g2 * fb[2] + w * fext.z();
           }
+          if constexpr (kFields) {
+            // First mass moment w m_p (x_p - x_i) of the particle's field (contact normals).
+            const Real wm = w * m;
+            a.gx -= wm * off[0][i];
+            a.gy -= wm * off[1][j];
+            a.gz -= wm * off[2][k];
+          }
         }
       }
     }
   }
-  for (int a = 0; a < Pad::E; ++a)
-    for (int b = 0; b < Pad::E; ++b)
-      for (int c = 0; c < Pad::Ez; ++c) {
-        const NodeAccum& n = buf[Pad::Index(a, b, c)];
-        if (n.m == 0 && n.px == 0 && n.py == 0 && n.pz == 0 && n.fx == 0 && n.fy == 0 && n.fz == 0)
-          continue;
-        const long g = PaddedToGrid(grid, blk, a, b, c);
-        SURGE_ASSERT(g >= 0);
-        if (g < 0) continue;
-        grid.momentum[g] += Vec3(n.px, n.py, n.pz);
-        if constexpr (kFull) {
-          grid.mass[g] += n.m;
-          grid.force[g] += Vec3(n.fx, n.fy, n.fz);
+  if constexpr (kFields) {
+    FlushFields<Pad>(grid, blk, buf);
+  } else {
+    for (int a = 0; a < Pad::E; ++a)
+      for (int b = 0; b < Pad::E; ++b)
+        for (int c = 0; c < Pad::Ez; ++c) {
+          const NodeAccum& n = buf[Pad::Index(a, b, c)];
+          if (n.m == 0 && n.px == 0 && n.py == 0 && n.pz == 0 && n.fx == 0 && n.fy == 0 && n.fz == 0)
+            continue;
+          const long g = PaddedToGrid(grid, blk, a, b, c);
+          SURGE_ASSERT(g >= 0);
+          if (g < 0) continue;
+          grid.momentum[g] += Vec3(n.px, n.py, n.pz);
+          if constexpr (kFull) {
+            grid.mass[g] += n.m;
+            grid.force[g] += Vec3(n.fx, n.fy, n.fz);
+          }
         }
-      }
+  }
 }
 
-template <int kDim, class K, bool kApic, bool kFull>
-void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& grid) {
+template <int kDim, class K, bool kApic, bool kFull, bool kFields>
+void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& grid,
+             const int* body_field) {
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
     ParallelFor(blocks.size(), 1, [&](size_t i) {
-      thread_local std::vector<NodeAccum> buf;
-      ScatterBlock<kDim, K, kApic, kFull>(ctx, particles, grid, blocks[i], buf);
+      thread_local std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>> buf;
+      ScatterBlock<kDim, K, kApic, kFull, kFields>(ctx, particles, grid, blocks[i], buf,
+                                                   body_field);
     });
   }
 }
 
-template <bool kFull>
+template <bool kFull, bool kFields = false>
 void ScatterDispatch(const Model& model, const StepContext& ctx, const Particles& particles,
                      SparseGrid& grid) {
   const bool apic = model.transfer == TransferScheme::kApic;
+  const int* body_field = model.body_field.data();
   DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
     if (apic)
-      Scatter<kDim, K, true, kFull>(ctx, particles, grid);
+      Scatter<kDim, K, true, kFull, kFields>(ctx, particles, grid, body_field);
     else
-      Scatter<kDim, K, false, kFull>(ctx, particles, grid);
+      Scatter<kDim, K, false, kFull, kFields>(ctx, particles, grid, body_field);
   });
 }
 
@@ -132,7 +188,21 @@ void ScatterDispatch(const Model& model, const StepContext& ctx, const Particles
 
 void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles& particles,
                     SparseGrid& grid) {
-  ScatterDispatch<true>(model, ctx, particles, grid);
+  if (model.field_count == 0) {
+    grid.field_count = 0;
+    ScatterDispatch<true>(model, ctx, particles, grid);
+    return;
+  }
+  // Per-body velocity fields: zeroed each step, only where a scene has body contacts.
+  const size_t n = size_t(model.field_count) * grid.mass.size();
+  grid.field_count = model.field_count;
+  grid.field_mass.assign(n, 0.0);
+  grid.field_momentum.assign(n, Vec3::Zero());
+  grid.field_force.assign(n, Vec3::Zero());
+  grid.field_mass_moment.assign(n, Vec3::Zero());
+  grid.field_velocity.assign(n, Vec3::Zero());  // stays zero where a field has no mass
+  grid.field_velocity_new.assign(n, Vec3::Zero());
+  ScatterDispatch<true, true>(model, ctx, particles, grid);
 }
 
 void RemapMomentum(const Model& model, const StepContext& ctx, const Particles& particles,

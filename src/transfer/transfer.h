@@ -2,8 +2,10 @@
 // Each reads what its comment says and writes only its outputs.
 #pragma once
 #include <array>
+#include <cstdint>
 #include <vector>
 
+#include "contact/contact_report.h"
 #include "core/model.h"
 #include "core/particles.h"
 #include "core/step_context.h"
@@ -20,7 +22,8 @@ void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& gri
 void BinParticles(SparseGrid& grid);
 
 // P2G (2.12): lumped mass, momentum (with the APIC affine term when selected), internal force
-// -sum V_p sigma_p grad N_ip and particle traction forces. Race-free and deterministic: blocks
+// -sum V_p sigma_p grad N_ip and particle traction forces; with body contacts
+// (Model::field_count > 0) also per field, plus each field's mass gradient. Race-free and deterministic: blocks
 // of one colour never share nodes; every node sum has a fixed order for any thread count.
 void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles& particles,
                     SparseGrid& grid);
@@ -41,6 +44,28 @@ struct WallReport {
 // walls' share), report.
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report);
+
+// Contact between MPM bodies of the last step (ApplyBodyContact).
+struct BodyContactReport {
+  std::vector<Vec3> force;    // by velocity field: force the other bodies exert on it [N]
+  int64_t contact_nodes = 0;  // nodes where two or more fields have mass
+  // By Model::body_contacts: the force on the pair's normal body from the other (BodyContact::
+  // name); torque about the origin; contact nodes = nodes where the correction acted on it;
+  // wetted height = extent of those nodes along -g.
+  std::vector<ObstacleForce> pairs;
+};
+
+// Per-body velocity fields (Model::body_contacts; body_contact.cpp has the algorithm and its
+// sources): at nodes where two or more fields have mass, corrects each field's velocity against
+// the common one (no interpenetration, Coulomb friction, free separation), then applies the
+// walls to each field. Run after the grid update and the obstacle contact. Reads the field
+// arrays of ParticleToGrid and the common velocity, velocity_new. Writes field_velocity,
+// field_velocity_new, reaction (sensors only); adds the walls' extra reaction to walls_report.
+void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& grid,
+                      WallReport& walls_report, BodyContactReport& report);
+
+// Index into Model::body_contacts of the pair of fields (f, g), [f * field_count + g], or -1.
+std::vector<int> BodyContactPairTable(const Model& model);
 
 // G2P (2.22) with the selected transfer (FLIP increment, PIC/FLIP blend, APIC) and the position
 // update x += dt sum N v_{n+1}. When velocity_gradient is non-null it also writes

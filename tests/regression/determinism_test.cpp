@@ -88,6 +88,14 @@ TEST(DeterminismTest, MuslSceneIsBitwiseIdenticalForOneAndTwoThreads) {
   EXPECT_EQ(h1, h2);
 }
 
+// Per-body velocity fields (body_contact): debris against an MPM barrier, past first contact.
+TEST(DeterminismTest, BodyContactSceneIsBitwiseIdenticalForOneAndTwoThreads) {
+  const std::vector<std::string> coarse = {"grid.cell_size=0.2"};
+  const uint64_t h1 = RunWithThreads("debris_flexible_barrier_2d.yaml", coarse, 0.8, 1);
+  const uint64_t h2 = RunWithThreads("debris_flexible_barrier_2d.yaml", coarse, 0.8, 2);
+  EXPECT_EQ(h1, h2);
+}
+
 }  // namespace
 }  // namespace surge
 
