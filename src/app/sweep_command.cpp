@@ -271,8 +271,8 @@ class Runner {
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    // Own process group: a terminal Ctrl-C reaches only the sweep, which passes on exactly one
-    // SIGINT per child (a second SIGINT would not let `surge run` finish its step cleanly).
+    // Own process group: a terminal Ctrl-C reaches only the sweep, which passes it on to every
+    // case; a SIGINT or SIGTERM sent to the sweep alone (kill, Slurm) stops the cases as well.
     posix_spawnattr_t attr;
     posix_spawnattr_init(&attr);
     sigset_t defaults, none;
