@@ -1,13 +1,16 @@
 // Two-way coupling of dynamic obstacles (Bullet) with the MPM (issue #5): a light box dropped
-// into water floats in force balance (its Archimedes draft d = (rho_box / rho_water) H is not
-// reached yet: see the known gap below); a dense box sinks to the floor and rests there (Bullet
-// contact with the domain wall); and a box far from any material falls freely under the
-// (ramped) gravity the coupling applies.
+// into water floats in force balance, a few per cent deeper than its Archimedes draft
+// d = (rho_box / rho_water) H at the resolutions a test can afford (see the known gap below); a
+// dense box sinks to the floor and rests there (Bullet contact with the domain wall); and a box
+// far from any material falls freely under the (ramped) gravity the coupling applies.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "support/obstacle_checks.h"
 #include "support/run_scene.h"
@@ -15,102 +18,191 @@
 namespace surge {
 namespace {
 
-// A 3-D slab two cells thick between slip walls (z): water 0.16 m deep in a 0.6 m tank, and a
-// 0.2 m wide, 0.1 m high box spanning the slab, released with its bottom on the water surface.
-// (A square section at half the water's density would capsize: a rectangular prism floats
-// upright only for width / height > sqrt(6 s (1 - s)) = 1.22 at s = 0.5.)
-std::string FloatScene(Real box_density, Real dx = 0.02, const std::string& antilocking = "node") {
-  const std::string slab = std::to_string(2 * dx);  // two cells thick
+// A tank for a floating box: a 3-D slab two cells thick between slip walls (z), water `water`
+// deep in a tank `tank` wide, and a box `width` x `height` spanning the slab, centred, released
+// at rest with its bottom on the water surface. The defaults are the coarse tank of the
+// regression test: water 0.16 m deep in a 0.6 m tank, a 0.2 m wide, 0.1 m high box. (A square
+// section at half the water's density would capsize: a rectangular prism floats upright only for
+// width / height > sqrt(6 s (1 - s)) = 1.22 at s = 0.5.)
+struct Tank {
+  Real dx = 0.02;                       // cell size h [m]
+  Real width = 0.2, height = 0.1;       // box section [m]
+  Real tank = 0.6, water = 0.16;        // tank width, initial water depth [m]
+  Real bulk = 2.0e5, viscosity = 5.0;   // water: K [Pa], mu [Pa s] (see FloatingBox)
+  Real end = 2.0, average_from = 1.5;   // run end and start of the averaging window [s]
+  std::string antilocking = "none";
+};
+
+std::string FloatScene(const Tank& t, Real box_density) {
+  auto s = [](Real v) { return std::to_string(v); };
+  const std::string slab = s(2 * t.dx);  // two cells thick
+  const Real x0 = 0.5 * (t.tank - t.width);
   return R"(name: floating_box
 dimension: 3
-time: {end: 1.6, cfl: 0.3}
+time: {end: )" + s(t.end) + R"(, cfl: 0.3}
 gravity: [0, -9.81, 0]
 gravity_ramp: 0.1
-grid: {cell_size: )" + std::to_string(dx) + R"(, shape_function: quadratic_bspline, transfer: apic, update: usl}
+grid: {cell_size: )" + s(t.dx) + R"(, shape_function: quadratic_bspline, transfer: apic, update: usl}
 domain:
   min: [0, 0, 0]
-  max: [0.6, 0.4, )" + slab + R"(]
+  max: [)" + s(t.tank) + ", 0.4, " + slab + R"(]
   walls: {x-: slip, x+: slip, y-: slip, z-: slip, z+: slip}
 materials:
-  water: {model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e5, viscosity: 0.01,
-          antilocking: {method: )" + antilocking + R"(}}
+  water: {model: newtonian_fluid, density: 1000, bulk_modulus: )" + s(t.bulk) +
+         ", viscosity: " + s(t.viscosity) + R"(,
+          antilocking: {method: )" + t.antilocking + R"(}}
 bodies:
   - name: water
     material: water
-    region: {box: {min: [0, 0, 0], max: [0.6, 0.16, )" + slab + R"(]}}
+    region: {box: {min: [0, 0, 0], max: [)" + s(t.tank) + ", " + s(t.water) + ", " + slab + R"(]}}
     particles_per_cell: 2
 obstacles:
   - name: box
-    shape: {box: {min: [0.2, 0.16, 0], max: [0.4, 0.26, )" + slab + R"(]}}
-    motion: {dynamic: {density: )" + std::to_string(box_density) + R"(}}
+    shape: {box: {min: [)" + s(x0) + ", " + s(t.water) + R"(, 0], max: [)" + s(x0 + t.width) +
+         ", " + s(t.water + t.height) + ", " + slab + R"(]}}
+    motion: {dynamic: {density: )" + s(box_density) + R"(}}
 )";
 }
 
+// The coarse tank with water of viscosity 0.01 Pa s and node anti-locking (the sinking box).
+std::string FloatScene(Real box_density) {
+  Tank t;
+  t.viscosity = 0.01;
+  t.antilocking = "node";
+  return FloatScene(t, box_density);
+}
+
 struct Floating {
-  Real draft, expected, force, weight;
+  Real draft;       // box bottom below the open water's surface [m]
+  Real draft_tank;  // below the surface that the whole tank's water mass gives [m]
+  Real expected;    // Archimedes [m]
+  Real force, weight;  // mean water force on the box and its weight [N]
 };
 
-Floating FloatingBox(Real dx, const std::string& antilocking) {
-  constexpr Real kRhoW = 1000, kRhoB = 500, kH = 0.1, kWidth = 0.2, kTank = 0.6;
-  const Real kSlab = 2 * dx;
-  LoadedScene scene = LoadSceneFromString(FloatScene(kRhoB, dx, antilocking), "floating_box.yaml");
+// Drops a box of half the water's density into the tank and measures its draft against
+// Archimedes, averaged over [average_from, end]. The viscosity (5 Pa s by default) only damps
+// the heave (at rest the viscous stress is zero, so the equilibrium is that of any fluid): with
+// 0.01 Pa s the box still swings by +-5 mm after 1 s at h = 0.0125 m. The water is slightly
+// compressible (sigma_m = (K/J) ln J, so rho / rho0 - 1 = p / K to first order, c = rho0 g / K):
+//  - the box's buoyancy per area is int_0^d rho g dz = rho0 g (d + c d^2 / 2), so Archimedes
+//    gives d_A = d0 (1 - c d0 / 2), d0 = (rho_b / rho_w) H;
+//  - the surface s of the open water (the columns beside the box, tank - width wide) follows
+//    from their mass per area m = rho0 (s + c s^2 / 2).
+// Archimedes compares the box with the water around it, so the draft is taken from the open
+// water. The surface that the whole tank's mass gives (box bottom y_b:
+// M / (rho0 b) = (tank - width) s + width y_b + c ((tank - width) s^2 / 2 + width (s y_b -
+// y_b^2 / 2))) reads too high: the particles under the box crowd (their mass per volume exceeds
+// rho0 / J by 1-5 % at h = 0.02 m, 11 % in a tight tank at h = 0.04 m), so that water fills less
+// height than its mass says. The visible surface (top particle of each open column + h / 4) is
+// printed as a check of the open-water surface.
+Floating FloatingBox(const Tank& t) {
+  constexpr Real kRhoW = 1000, kRhoB = 500, kG = 9.81;
+  const Real slab = 2 * t.dx, open = t.tank - t.width, c = kRhoW * kG / t.bulk;
+  LoadedScene scene = LoadSceneFromString(FloatScene(t, kRhoB), "floating_box.yaml");
   const Real water_mass = testing::TotalMass(scene.state.particles);
-  const Real water_area = water_mass / (kRhoW * kSlab);  // incompressible water cross-section
-  Real bottom = 0, force_y = 0;
+  Real bottom = 0, force_y = 0, open_mass = 0, visible = 0, tilt = 0;
   int n = 0;
-  Real tilt = 0;
-  testing::RunUntil(scene, 1.6, [&](const State& s, const StepReport& r) {
-    tilt = std::max(tilt, std::acos(std::min(Real(1), s.rigid.at(0).rotation(1, 1))));
-    if (s.time < 1.1) return;
-    bottom += s.rigid.at(0).position.y() - 0.5 * kH;  // reference point = box centre
-    force_y += r.obstacles.at(0).force.y();            // the water's push on the box, upward
+  const int bins = int(std::lround(t.tank / (0.5 * t.dx)));  // columns h / 2 wide
+  std::vector<Real> top(static_cast<size_t>(bins));
+  const auto started = std::chrono::steady_clock::now();
+  testing::RunUntil(scene, t.end, [&](const State& s, const StepReport& r) {
+    const RigidBodyState& b = s.rigid.at(0);
+    tilt = std::max(tilt, std::acos(std::min(Real(1), b.rotation(1, 1))));
+    if (s.time < t.average_from) return;
+    bottom += b.position.y() - 0.5 * t.height;  // reference point = box centre
+    force_y += r.obstacles.at(0).force.y();     // the water's push on the box, upward
+    const Real x0 = b.position.x() - 0.5 * t.width, x1 = x0 + t.width;
+    std::fill(top.begin(), top.end(), Real(0));
+    const Particles& P = s.particles;
+    for (size_t p = 0; p < P.size(); ++p) {
+      const Real x = P.x[p].x();
+      if (x >= x0 && x <= x1) continue;  // under the box
+      open_mass += P.mass[p];
+      const size_t col = size_t(std::clamp(int(x / (0.5 * t.dx)), 0, bins - 1));
+      top[col] = std::max(top[col], P.x[p].y());
+    }
+    Real sum = 0;
+    int cols = 0;
+    for (int k = 0; k < bins; ++k) {
+      const Real xc = (k + 0.5) * 0.5 * t.dx;
+      if (xc > x0 && xc < x1) continue;
+      sum += top[size_t(k)];
+      ++cols;
+    }
+    visible += sum / cols + 0.25 * t.dx;  // a particle stands for h / 2 of height
     ++n;
   });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   bottom /= n;
   force_y /= n;
+  visible /= n;
+  open_mass /= n;
   const Real deepest = -testing::MaxPenetration(scene);
   std::printf("deepest particle inside the box at the end %.3g m; largest tilt %.2e rad\n",
               -deepest, tilt);
   // Explicit coupling: the contact saw the body at t_n, so particles may lie v dt inside its
   // pose at t_{n+1}; the next step's contact and projection take them out.
-  EXPECT_LT(-deepest, 1e-4 * dx);
+  EXPECT_LT(-deepest, 1e-4 * t.dx);
   EXPECT_LT(tilt, 1e-3);  // a stable section (width / height 2) stays upright
-  // Surface level h_s with the box in it: (tank - width) h_s + width y_b = water area.
-  const Real surface = (water_area - kWidth * bottom) / (kTank - kWidth);
-  const Real draft = surface - bottom, expected = kRhoB / kRhoW * kH;
-  const Real weight = kRhoB * kH * kWidth * kSlab * 9.81;
-  std::printf("floating box (h = %g m, anti-locking %s): draft %.5f m, Archimedes %.5f m (error "
-              "%+.2f %%); mean water force %.4f N, weight %.4f N (%+.2f %%); box bottom %.4f m, "
-              "surface %.4f m\n",
-              dx, antilocking.c_str(), draft, expected, 100 * (draft / expected - 1), force_y,
-              weight, 100 * (force_y / weight - 1), bottom, surface);
-  return {draft, expected, force_y, weight};
+  // Open water: m = rho0 (s + c s^2 / 2), fixed point (c s / 2 < 1 %).
+  const Real per_area = open_mass / (kRhoW * slab * open);
+  Real surface = per_area;
+  for (int k = 0; k < 20; ++k) surface = per_area - c * surface * surface / 2;
+  // Whole tank, the same way.
+  const Real area = water_mass / (kRhoW * slab);
+  Real tank_surface = (area - t.width * bottom) / open;
+  for (int k = 0; k < 20; ++k) {
+    const Real depth_area = open * tank_surface * tank_surface / 2 +
+                            t.width * (tank_surface * bottom - bottom * bottom / 2);
+    tank_surface = (area - c * depth_area - t.width * bottom) / open;
+  }
+  const Real d0 = kRhoB / kRhoW * t.height, expected = d0 * (1 - c * d0 / 2);
+  const Real weight = kRhoB * t.height * t.width * slab * kG;
+  const Real draft = surface - bottom, draft_tank = tank_surface - bottom;
+  auto err = [&](Real d) { return 100 * (d / expected - 1); };
+  std::printf("floating box (h = %g m, %.2f cells per draft, anti-locking %s, mu %g Pa s): draft "
+              "%.5f m below the open water (error %+.2f %%; visible surface %+.2f %%; whole "
+              "tank's mass %+.2f %%), Archimedes %.5f m; mean water force %.4f N, weight %.4f N "
+              "(%+.2f %%); box bottom %.4f m; %.1f s\n",
+              t.dx, expected / t.dx, t.antilocking.c_str(), t.viscosity, draft, err(draft),
+              err(visible - bottom), err(draft_tank), expected, force_y, weight,
+              100 * (force_y / weight - 1), bottom, seconds);
+  return {draft, draft_tank, expected, force_y, weight};
 }
 
 // KNOWN GAP (issue #5 asks for the draft within 3 %): at h = 0.02 m (2.5 cells of draft) the
-// box floats 11 % too deep without anti-locking (26 % before off-grid faces kept their edge
-// nodes, commit 8d561b8). The coupling is not the cause: a fixed box held at the same depth gets
-// the same upward force. The water's force on a downward-facing face (a lid) is low at coarse
-// resolution: a pressure offset of the water under the box that depends on the structures and
-// passages around it, plus the face's sub-cell offset; it converges (2-D lids within 1.2 % at
-// 20 cells of depth; docs/validation.md). Until the coarse case is fixed this test holds the
-// coupling to what it does right (force balance, no penetration, no tilt) and the draft to the
-// measured error band, so that a regression or a fix both show.
+// box floats 4.9 % deeper than Archimedes, and refining does not close the gap at the cost of a
+// test (DISABLED_FloatingBoxResolution: 2.5 / 3.3 / 4 / 5 cells per draft give +4.9 / +17.2 /
+// +7.5 / +3.2 %; the error follows where the bottom rests between node planes). The coupling is
+// not the cause: the box is in force balance, and a fixed box held at that depth gets the same
+// upward force. The water's force on a downward-facing face (a lid) is low at coarse resolution
+// and depends on the face's sub-cell offset (docs/validation.md). Until that is fixed this test
+// holds the coupling to what it does right (force balance, no penetration, no tilt) and the
+// draft to the measured band, so that a regression or a fix both show. The +11 % reported before
+// 2026-11-23 was mostly measurement: the draft was taken from the whole tank's mass with
+// incompressible water (+2.1 points) and the particles under the box crowd (+4 to +5 points;
+// see FloatingBox).
 TEST(RigidCouplingTest, LightBoxFloatsInForceBalanceWithTheKnownLidForceDeficit) {
-  const Floating f = FloatingBox(0.02, "none");
+  const Floating f = FloatingBox(Tank{});
   EXPECT_NEAR(f.force, f.weight, 0.03 * f.weight);  // at rest the water carries the box
   EXPECT_GT(f.draft, f.expected);                    // deeper than Archimedes (the known gap)
-  EXPECT_LT(f.draft, 1.2 * f.expected);              // measured +11 %
+  EXPECT_LT(f.draft, 1.08 * f.expected);             // measured +4.9 %
+  EXPECT_GT(f.draft_tank, f.draft);                  // the crowding under the box
 }
 
-// The draft error against resolution and anti-locking (about 3 min; run by hand with
-// --gtest_also_run_disabled_tests --gtest_filter=*Resolution*). Measured 2026-11-23 before
-// commit 8d561b8: h = 0.02 node +57 %, none +26 %; h = 0.01 none +27 %, node +48 %.
+// The draft error against resolution in the coarse tank (about 4 min single-threaded; run by
+// hand with --gtest_also_run_disabled_tests --gtest_filter=*Resolution*). Measured 2026-11-23
+// (draft below the open water, compressible Archimedes): see docs/validation.md.
 TEST(RigidCouplingTest, DISABLED_FloatingBoxResolution) {
-  FloatingBox(0.02, "node");
-  FloatingBox(0.02, "none");
-  FloatingBox(0.01, "none");
-  FloatingBox(0.01, "node");
+  for (const Real dx : {0.02, 0.015, 0.0125, 0.01}) {
+    Tank t;
+    t.dx = dx;
+    FloatingBox(t);
+  }
+  Tank node;
+  node.antilocking = "node";
+  FloatingBox(node);
 }
 
 TEST(RigidCouplingTest, DenseBoxSinksAndRestsOnTheFloor) {
