@@ -151,7 +151,7 @@ Json Build(const ForcesCommandOptions& o, bool lenient) {
     spec.dimension = r.dimension;
   }
   AnalysisSettings written = spec.analysis.settings;
-  if (!o.structure.empty()) {
+  if (!o.structure.empty() && o.structure != written.structure) {  // another structure
     written.structure = o.structure;
     written.face.clear();
     written.component.reset();

@@ -458,6 +458,10 @@ ForceAnalysis AnalyseForce(const ForceSignal& signal, ForceComponent component,
                                        f_ss, std::isnan(a.a_act_pk) ? 0 : a.a_act_pk, a.a_act_ss,
                                        settings.reference);
   if (!a.steady.found && !a.steady.note.empty()) a.notes.push_back(a.steady.note);
+  if (a.steady.found && std::abs(a.steady.mean) <= 1e-3 * std::abs(a.peak.value)) {
+    a.notes.push_back("the steady state is (nearly) zero: the load ended before the run did; "
+                      "give steady_state.window for the flow phase");
+  }
   return a;
 }
 

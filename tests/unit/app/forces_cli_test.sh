@@ -119,6 +119,7 @@ fi
 expect forces_override_structure 0 '"structure": "domain"' -- "$surge" forces "$out/fa.h5" --json --obstacle domain --face y- --component y
 expect forces_override_window 0 '"status": "window"' -- "$surge" forces "$out/fa.h5" --json --window 0.3 0.4
 expect forces_override_velocity 0 '"velocity": 2' -- "$surge" forces "$out/fa.h5" --json --velocity 2 --smooth low_pass=50
+expect forces_same_structure_keeps_face 0 '"face": "x-",' -- "$surge" forces "$out/fa.h5" --json --obstacle wall
 expect forces_structure_drops_face 0 '"face": "",' -- "$surge" forces "$out/fa.h5" --json --obstacle domain
 # Errors.
 expect forces_missing_file 2 "no such file" -- "$surge" forces "$work/none.h5"
@@ -130,7 +131,7 @@ if [ -x "$py" ] && "$py" -c 'import h5py' 2> /dev/null; then
 fi
 expect forces_unknown_structure 2 "no structure 'pier'.*structures: domain, wall" -- "$surge" forces "$out/fa.h5" --obstacle pier
 expect forces_unknown_face 2 "structure 'wall' has no face 'side' \(faces: x-, x\+, y-, y\+\)" -- "$surge" forces "$out/fa.h5" --face side
-expect forces_normal_needs_axis_face 2 "component normal needs an axis face" -- "$surge" forces "$out/fa.h5" --obstacle wall --component normal
+expect forces_normal_needs_axis_face 2 "component normal needs an axis face" -- "$surge" forces "$out/fa.h5" --obstacle domain --component normal
 expect forces_bad_smooth 2 "unknown filter 'gauss'" -- "$surge" forces "$out/fa.h5" --smooth gauss=1
 expect forces_nyquist 2 "Nyquist" -- "$surge" forces "$out/fa.h5" --smooth low_pass=1e6
 # Impossible filter settings in the scene: the run still writes summary.json, with a note.
