@@ -174,7 +174,8 @@ Floating FloatingBox(const Tank& t) {
 // KNOWN GAP (issue #5 asks for the draft within 3 %): at h = 0.02 m (2.5 cells of draft) the
 // box floats 4.9 % deeper than Archimedes, and refining does not close the gap at the cost of a
 // test (DISABLED_FloatingBoxResolution: 2.5 / 3.3 / 4 / 5 cells per draft give +4.9 / +17.2 /
-// +7.5 / +3.2 %; the error follows where the bottom rests between node planes). The coupling is
+// +7.5 / +3.2 %, and 6.7 cells (h = 0.0075 m, 256 s) +7.5 %; the error follows where the bottom
+// rests between node planes). The coupling is
 // not the cause: the box is in force balance, and a fixed box held at that depth gets the same
 // upward force. The water's force on a downward-facing face (a lid) does not see where the face
 // lies within a cell: the node contact knows only which nodes are inside it, and fixed 2-D lids
