@@ -990,6 +990,7 @@ AnalysisSpec Parser::ParseAnalysis(const YAML::Node& n, const SceneSpec& spec) c
     std::vector<std::string> names = {"domain"};
     for (const ObstacleSpec& o : spec.obstacles) names.push_back(o.name);
     for (const SensorSpec& o : spec.sensors) names.push_back(o.name);
+    for (const BodyContactSpec& c : spec.body_contacts) names.push_back(c.bodies[1] + "_on_" + c.bodies[0]);
     if (std::find(names.begin(), names.end(), s.structure) == names.end()) {
       Fail(n["structure"], "analysis.structure",
            "unknown structure '" + s.structure + "' (expected one of: " + Join(names) + ")");
