@@ -4,6 +4,7 @@
 Usage:
   /usr/bin/python3 scripts/plot_sweep.py SWEEP.csv --x wc --y phi [--quantities f_pk f_ss ...]
                                          [--out PNG]
+  /usr/bin/python3 scripts/plot_sweep.py SWEEP.csv --histories [--match REGEX] [--out PNG]
 
 Reads <out>/sweep.csv of `surge sweep` (one row per case: the parameters, then the flattened
 summary.json) and draws, for each quantity, a contour plot over the (x, y) plane (seed Figs
@@ -24,8 +25,17 @@ Quantities (docs/forces.md; Mast 2013 eqs. 7.14, 7.18-7.19):
 
 Default quantities: f_pk f_ss c_pk c_ss r_pk_hb r_ss_hb. Cases that are not completed, and
 empty cells (a steady state that was not found), are left out; the title says how many.
-Default output: sweep.png beside the CSV. Needs Debian's python3-matplotlib.
+Default output: sweep.png beside the CSV.
+
+--histories instead draws the analysed force series of every completed case in one panel (seed
+Fig. 7.34), each case's <case>/<scene>.h5 read with the structure, face and component of its
+summary.json, the steady-state value drawn over its window where one was found; --match keeps
+the cases whose name matches a regular expression (e.g. 'wc=3_'). Default output:
+sweep_histories.png. Needs Debian's python3-matplotlib (and python3-h5py for --histories).
 """
+import glob
+import json
+import re
 import argparse
 import csv
 import os
@@ -60,15 +70,73 @@ def number(cell):
         return None
 
 
+def histories(args):
+    """The analysed force series of every completed case, with its steady state."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import h5py
+    from plot_forces import component  # the same scalar as surge forces
+    folder = os.path.dirname(os.path.abspath(args.csv))
+    with open(args.csv, newline="", encoding="utf-8") as f:
+        rows = [r for r in csv.DictReader(f) if r.get("status") == "completed"
+                and (not args.match or re.search(args.match, r["case"]))]
+    if not rows:
+        sys.exit(f"{args.csv}: no completed case" + (f" matching '{args.match}'" if args.match else ""))
+    fig, ax = plt.subplots(figsize=(9, 5))
+    if len(rows) > 10:  # distinct colours for up to 20 cases
+        ax.set_prop_cycle(color=plt.get_cmap("tab20").colors)
+    label = ""
+    for r in rows:
+        case = os.path.join(folder, r["case"])
+        results = glob.glob(os.path.join(case, "*.h5"))
+        summary_path = os.path.join(case, "summary.json")
+        if len(results) != 1 or not os.path.isfile(summary_path):
+            print(f"{case}: skipped (no single .h5 with a summary.json)", file=sys.stderr)
+            continue
+        with open(summary_path, encoding="utf-8") as f:
+            a = json.load(f).get("analysis")
+        if a is None:
+            continue
+        with h5py.File(results[0], "r") as f:
+            group = f["forces"][a["structure"]]
+            series = group["faces"][a["face"]] if a.get("face") else group
+            time, force = group["time"][:], series["force"][:]
+        x = component(force, a["component"], a.get("face", ""))
+        line, = ax.plot(time, x / 1e3, lw=0.9, label=r["case"])
+        ss = a["steady_state"]
+        if ss["status"] != "none" and ss["value"] is not None:
+            ax.hlines(ss["value"] / 1e3, ss["t0"], ss["t1"], color=line.get_color(), lw=2.5,
+                      alpha=0.6)
+        label = a["structure"] + (f"/{a['face']}" if a.get("face") else "") + f" {a['component']}"
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("force [kN]")
+    ax.set_title(f"{label}; thick: steady state over its window", fontsize=9, loc="left")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.suptitle(os.path.basename(folder), fontsize=10)
+    fig.tight_layout()
+    out = args.out or os.path.join(folder, "sweep_histories.png")
+    fig.savefig(out, dpi=110)
+    print(out)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("csv", help="the sweep's sweep.csv")
-    parser.add_argument("--x", required=True, help="parameter column on the horizontal axis")
-    parser.add_argument("--y", required=True, help="parameter column: contour axis / one cut each")
+    parser.add_argument("--x", help="parameter column on the horizontal axis")
+    parser.add_argument("--y", help="parameter column: contour axis / one cut each")
+    parser.add_argument("--histories", action="store_true",
+                        help="the force series of every case in one panel instead")
+    parser.add_argument("--match", metavar="REGEX",
+                        help="with --histories: only the cases whose name matches")
     parser.add_argument("--quantities", nargs="+", default=DEFAULT, metavar="Q",
                         help=f"what to plot (default: {' '.join(DEFAULT)})")
     parser.add_argument("--out", help="PNG to write (default: sweep.png beside the CSV)")
     args = parser.parse_args()
+    if args.histories:
+        histories(args)
+        return
+    if not args.x or not args.y:
+        parser.error("--x and --y are required (or --histories)")
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.csv)), "sweep.png")
 
     with open(args.csv, newline="", encoding="utf-8") as f:

@@ -136,6 +136,8 @@ fi
 # The plot scripts on the sweep's results.
 if "$py" "$src/scripts/plot_sweep.py" "$csv" --x parameters.wc --y parameters.phi --out "$work/sweep.png" >/dev/null \
    && [ -s "$work/sweep.png" ]; then ok plot_sweep; else bad plot_sweep; fi
+if "$py" "$src/scripts/plot_sweep.py" "$csv" --histories --out "$work/histories.png" >/dev/null \
+   && [ -s "$work/histories.png" ]; then ok plot_sweep_histories; else bad plot_sweep_histories; fi
 case3=$(ls -d "$work"/ci/case_001_wc3_phi20 2>/dev/null)
 if "$py" "$src/scripts/plot_forces.py" "$case3/column_impact_3d.h5" --analysis --out "$work/analysis.png" >/dev/null \
    && [ -s "$work/analysis.png" ]; then ok plot_forces_analysis; else bad plot_forces_analysis; fi

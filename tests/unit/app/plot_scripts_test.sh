@@ -37,6 +37,7 @@ png plot_forces_analysis "$work/a.png" -- "$py" "$src/scripts/plot_forces.py" "$
 png plot_forces_analysis_default_name "${h5%.h5}_analysis.png" -- "$py" "$src/scripts/plot_forces.py" "$h5" --analysis
 png plot_sweep "$work/s.png" -- "$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --x w --y v --out "$work/s.png"
 png plot_sweep_default_name "$work/tiny/sweep.png" -- "$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --x v --y w --quantities f_pk analysis.impulse
+png plot_sweep_histories "$work/h.png" -- "$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --histories --match "w=0.2" --out "$work/h.png"
 
 out=$("$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --x width --y v 2>&1)
 if [ $? -ne 0 ] && grep -q "no column 'width'" <<<"$out"; then ok plot_sweep_bad_column; else bad "plot_sweep_bad_column: $out"; fi
