@@ -17,7 +17,10 @@
 //      of mass - were tried first: at a block's bottom corner they tilt by 27-90 degrees (the
 //      block's own edge dominates where the base has only a kernel tail of mass), the corner
 //      acts as a ramp, and a block on an incline stuck (a = 0 where g (sin th - mu cos th) =
-//      1.48 m/s^2; tests/verification/body_contact_test);
+//      1.48 m/s^2; tests/verification/body_contact_test). At nodes on or beyond a domain
+//      wall the component along the wall's normal is dropped (the wall cuts the body's
+//      material off there; with it, a 3-D block spanning a slab between two slip walls slid
+//      33 % slow);
 //   3. with dv = v_f - v_c: approaching when dv.n_f > 0 (6.4) (always, for a non-separable
 //      pair): the normal part is removed (6.9)-(6.12) and the tangential part is limited by
 //      Coulomb friction, |dv_t| <= mu |dv.n| (6.8) with (6.14): stick if below, else slip by
@@ -129,6 +132,11 @@ void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& gr
           const size_t mi = size_t(master) * N + i;
           Vec3 n = grid.field_mass_moment[mi] / grid.field_mass[mi];  // xbar - x_i
           if (master == f) n = -n;
+          // On or beyond a domain wall the body's material is cut off by the wall, which shifts
+          // its local centre of mass along the wall normal; a wall is a symmetry plane of the
+          // material (slip), so that component is dropped.
+          for (int k = 0; k < wall_count; ++k)
+            if (walls[k].sign * (x[walls[k].axis] - walls[k].level) <= tolerance) n[walls[k].axis] = 0;
           const Real n_norm = n.norm();
           n = n_norm > 1e-9 * ctx.dx ? Vec3(n / n_norm) : Vec3::Zero();  // zero: no normal part
           const Vec3 dv = w - vc;

@@ -49,6 +49,32 @@ bodies:
 )" + contact;
 }
 
+// The same in 3-D: a slab two cells thick in z between slip walls (1.5 m long).
+std::string InclineScene3D(Real theta_deg, const std::string& contact) {
+  const Real th = theta_deg * M_PI / 180;
+  return R"(name: block_on_slab_3d
+dimension: 3
+time: {end: 1.0, cfl: 0.4}
+gravity: [)" + std::to_string(kG * std::sin(th)) + ", " + std::to_string(-kG * std::cos(th)) + R"(, 0]
+grid: {cell_size: 0.05, shape_function: quadratic_bspline, transfer: apic, update: usl}
+domain:
+  min: [0, 0, 0]
+  max: [1.5, 0.6, 0.1]
+  walls: {x-: slip, x+: slip, y-: no_slip, z-: slip, z+: slip}
+materials:
+  stiff: {model: neo_hookean, density: 2000, youngs_modulus: 5.0e7, poisson_ratio: 0.3}
+bodies:
+  - name: slab
+    material: stiff
+    region: {box: {min: [0, 0, 0], max: [1.5, 0.2, 0.1]}}
+    particles_per_cell: 2
+  - name: block
+    material: stiff
+    region: {box: {min: [0.3, 0.2, 0], max: [0.55, 0.45, 0.1]}}
+    particles_per_cell: 2
+)" + contact;
+}
+
 struct BodyMotion {
   Real mass = 0;
   Vec3 momentum = Vec3::Zero();
@@ -77,8 +103,11 @@ struct Slide {
   Real block_weight = 0;                // m g [N/m]
 };
 
-Slide RunIncline(Real theta_deg, const std::string& contact, Real t_end = 0.6, Real t0 = 0.1) {
-  LoadedScene scene = LoadSceneFromString(InclineScene(theta_deg, contact), "block_on_slab.yaml");
+Slide RunIncline(Real theta_deg, const std::string& contact, Real t_end = 0.6, Real t0 = 0.1,
+                 int dim = 2) {
+  LoadedScene scene = LoadSceneFromString(
+      dim == 2 ? InclineScene(theta_deg, contact) : InclineScene3D(theta_deg, contact),
+      "block_on_slab.yaml");
   std::vector<Real> t, v;
   Slide out;
   Real largest = 0, imbalance = 0;  // max |F_block|, max |F_slab + F_block| [N/m]
@@ -128,6 +157,22 @@ TEST(BodyContactTest, BlockSlidesOnAnMpmSlabAtTheInclineAcceleration) {
               s.mean_pair_force.x(), s.mean_pair_force.y(), mu * normal, -normal);
   EXPECT_NEAR(s.mean_pair_force.y(), -normal, 0.02 * normal);
   EXPECT_NEAR(s.mean_pair_force.x(), mu * normal, 0.03 * mu * normal);
+}
+
+TEST(BodyContactTest, BlockSlidesOnAnMpmSlabIn3D) {
+  const Real theta = 25, mu = 0.3;
+  const Slide s = RunIncline(theta, "body_contact:\n  - {bodies: [slab, block], friction: 0.3}\n",
+                             0.5, 0.1, 3);
+  const Real th = theta * M_PI / 180;
+  const Real expected = kG * (std::sin(th) - mu * std::cos(th));
+  const Real normal = s.block_weight * std::cos(th);
+  std::printf("3-D block on an MPM slab: a = %.4f m/s^2, closed form %.4f (error %+.2f %%); "
+              "logged force on the slab (%.2f, %.2f) N, expected (%.2f, %.2f)\n",
+              s.acceleration, expected, 100 * (s.acceleration / expected - 1),
+              s.mean_pair_force.x(), s.mean_pair_force.y(), mu * normal, -normal);
+  EXPECT_NEAR(s.acceleration, expected, 0.03 * expected);
+  EXPECT_NEAR(s.mean_pair_force.y(), -normal, 0.02 * normal);
+  EXPECT_LT(s.worst_action_reaction, 1e-9);
 }
 
 TEST(BodyContactTest, WithoutBodyContactTheBlockIsWeldedToTheSlab) {
