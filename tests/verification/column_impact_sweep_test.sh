@@ -27,7 +27,8 @@
 #   w_c 3, phi 30: 111.2 / 88.2 over [2.85, 3.5] s, R_pk 0.98, R_ss 0.78
 # fits: peak = 9.7 + 66.1 w_c kN (R^2 0.9999), steady = 5.9 + 30.1 w_c kN (R^2 1.0000);
 # f_ss changes 8.4 % from phi 20 to 30. R_ss with H_act (eq. 7.19 literally): 0.24-0.40.
-# Not reproduced (docs/studies/column-impact.md): the seed's R_pk 3-9 (here 1-1.9).
+# Not reproduced (docs/studies/column-impact.md): the seed's R_pk 3-9 (here 1-1.9 with quadratic
+# B-splines; 7.1-8.7 with the seed's linear shape functions at w_c 3, phi 20).
 # Usage: column_impact_sweep_test.sh <surge binary> <source dir>
 set -u
 surge=$1
