@@ -7,6 +7,8 @@ bridge_pier.stl   rounded-nose pier (semicircular nose and tail), closed
 mound.obj         rounded earth mound (surface of revolution), closed
 v_deflector.stl   V-shaped deflector (two walls meeting at 90 degrees, apex upstream), closed
 terrain_patch.obj open height field (gentle slope with a bump), one-sided, normals up
+square_column.obj 1.5 x 1.5 m square column, 8.5 m tall from y = -0.5 (the seed's §7.5 column,
+                  sunk 0.5 m into the bed), centred on x = z = 0, closed; rotate it with rotate_deg
 
 Checks: closed meshes have every edge used exactly twice, in opposite directions (consistent
 orientation) and a positive volume (outward); no triangle has an area below 1e-6 * diagonal^2.
@@ -194,6 +196,9 @@ def main():
         ("v_deflector", "stl", v_deflector(), True, ""),
         ("terrain_patch", "obj", terrain_patch(), False,
          "terrain patch 20 m x 10 m, slope 0.05 with a 0.8 m bump, open (one-sided, normals up)"),
+        ("square_column", "obj",
+         prism([(-0.75, -0.75), (0.75, -0.75), (0.75, 0.75), (-0.75, 0.75)], -0.5, 8.0), True,
+         "square column 1.5 m x 1.5 m, y from -0.5 to 8 m, centred on x = z = 0, closed"),
     ]
     for name, ext, (vertices, triangles), closed, comment in meshes:
         check(name, vertices, triangles, closed)

@@ -59,6 +59,18 @@ TEST(AssetsTest, MoundIsClosedAndRounded) {
   EXPECT_LT(field.Query(Vec3(2.5, 3 * std::cos(M_PI * 2.5 / 6) - 0.1, 0), kInf).distance, 0);
 }
 
+TEST(AssetsTest, SquareColumnIsClosedAndSquare) {
+  const TriangleMesh mesh = Asset("square_column.obj");
+  EXPECT_EQ(CountOpenEdges(mesh), 0);
+  ExpectBounds(mesh, Vec3(-0.75, -0.5, -0.75), Vec3(0.75, 8, 0.75));
+  const MeshDistanceField field(mesh, false);
+  EXPECT_NEAR(field.Query(Vec3(0, 4, 0), kInf).distance, -0.75, 1e-6);  // on the axis
+  const MeshDistance front = field.Query(Vec3(-1.25, 4, 0.3), kInf);     // before face x-
+  EXPECT_NEAR(front.distance, 0.5, 1e-6);
+  EXPECT_GT(front.normal.dot(-Vec3::UnitX()), 0.99);
+  EXPECT_NEAR(field.Query(Vec3(1.75, 4, 1.75), kInf).distance, std::sqrt(2.0), 1e-6);  // corner
+}
+
 TEST(AssetsTest, VDeflectorIsClosedAndItsOpeningIsOutside) {
   const TriangleMesh mesh = Asset("v_deflector.stl");
   EXPECT_EQ(CountOpenEdges(mesh), 0);
