@@ -37,13 +37,8 @@ set -u
 surge=$1
 src=$2
 py=/usr/bin/python3
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$(dirname "$0")/../support/cli_checks.sh"
 cd "$work" || exit 1
-fail=0
-pass=0
-ok() { echo "ok   $1"; pass=$((pass + 1)); }
-bad() { echo "FAIL $1"; fail=$((fail + 1)); }
 
 # The seed's full study: 180 valid cases, and a Slurm array over them.
 full=$src/scenes/sweeps/column_impact_full.yaml
@@ -146,5 +141,4 @@ case3=$(ls -d "$work"/ci/case_001_wc3_phi20 2>/dev/null)
 if "$py" "$src/scripts/plot_forces.py" "$case3/column_impact_3d.h5" --analysis --out "$work/analysis.png" >/dev/null \
    && [ -s "$work/analysis.png" ]; then ok plot_forces_analysis; else bad plot_forces_analysis; fi
 
-echo "$pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish

@@ -4,25 +4,7 @@
 set -u
 surge=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fail=0
-pass=0
-
-expect() {  # expect <name> <expected exit code> <regex on combined output> -- command...
-  local name=$1 code=$2 regex=$3
-  shift 4
-  local out rc
-  out=$("$@" 2>&1)
-  rc=$?
-  if [ "$rc" -ne "$code" ]; then
-    echo "FAIL $name: exit $rc, expected $code"; echo "$out" | tail -5; fail=$((fail + 1)); return
-  fi
-  if ! grep -Eq -- "$regex" <<<"$out"; then
-    echo "FAIL $name: output does not match /$regex/"; echo "$out" | tail -5; fail=$((fail + 1)); return
-  fi
-  echo "ok   $name"; pass=$((pass + 1))
-}
+. "$(dirname "$0")/../../support/cli_checks.sh"
 
 expect info 0 'OpenVDB +10' -- "$surge" info
 expect check_good 0 'particles +1624' -- "$surge" check "$src/scenes/two_disks_2d.yaml"
@@ -123,5 +105,4 @@ if [ "$rc" -eq 130 ] && grep -q interrupted "$work/int.log" && [ -f "$work/int/e
 else
   echo "FAIL sigint: exit $rc"; tail -3 "$work/int.log"; fail=$((fail + 1))
 fi
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish cli

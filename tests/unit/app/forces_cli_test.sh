@@ -8,26 +8,9 @@
 set -u
 surge=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fail=0
-pass=0
+. "$(dirname "$0")/../../support/cli_checks.sh"
 py=/usr/bin/python3
 
-expect() {  # expect <name> <expected exit code> <regex on combined output> -- command...
-  local name=$1 code=$2 regex=$3
-  shift 4
-  local out rc
-  out=$("$@" 2>&1)
-  rc=$?
-  if [ "$rc" -ne "$code" ]; then
-    echo "FAIL $name: exit $rc, expected $code"; echo "$out" | tail -5; fail=$((fail + 1)); return
-  fi
-  if ! grep -Eq -- "$regex" <<<"$out"; then
-    echo "FAIL $name: output does not match /$regex/"; echo "$out" | tail -5; fail=$((fail + 1)); return
-  fi
-  echo "ok   $name"; pass=$((pass + 1))
-}
 
 check() {  # check <name> <command...>: passes when the command exits 0
   local name=$1
@@ -142,5 +125,4 @@ else
   echo "FAIL run_lenient_summary_json"; head -20 "$work/lenient/summary.json"; fail=$((fail + 1))
 fi
 expect forces_scene_error 2 "analysis.structure" -- "$surge" check "$work/fa.yaml" --set analysis.structure=pier
-echo "forces cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish "forces cli"

@@ -8,13 +8,8 @@ set -u
 surge=$1
 src=$2
 py=/usr/bin/python3
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$(dirname "$0")/../../support/cli_checks.sh"
 cd "$work" || exit 1
-fail=0
-pass=0
-ok() { echo "ok   $1"; pass=$((pass + 1)); }
-bad() { echo "FAIL $1"; fail=$((fail + 1)); }
 
 png() {  # png <name> <file> -- command...: the command exits 0 and writes a PNG
   local name=$1 file=$2
@@ -44,5 +39,4 @@ if [ $? -ne 0 ] && grep -q "no column 'width'" <<<"$out"; then ok plot_sweep_bad
 out=$("$py" "$src/scripts/plot_forces.py" "$h5" --analysis "$work/none.json" 2>&1)
 if [ $? -ne 0 ] && grep -q "none.json: no such file" <<<"$out"; then ok plot_forces_no_summary; else bad "plot_forces_no_summary: $out"; fi
 
-echo "$pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish

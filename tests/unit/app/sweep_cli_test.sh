@@ -6,28 +6,8 @@
 set -u
 surge=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$(dirname "$0")/../../support/cli_checks.sh"
 cd "$work" || exit 1
-fail=0
-pass=0
-ok() { echo "ok   $1"; pass=$((pass + 1)); }
-bad() { echo "FAIL $1"; fail=$((fail + 1)); }
-
-expect() {  # expect <name> <expected exit code> <regex on combined output> -- command...
-  local name=$1 code=$2 regex=$3
-  shift 4
-  local out rc
-  out=$("$@" 2>&1)
-  rc=$?
-  if [ "$rc" -ne "$code" ]; then
-    bad "$name: exit $rc, expected $code"; echo "$out" | tail -8; return
-  fi
-  if ! grep -Eq -- "$regex" <<<"$out"; then
-    bad "$name: output does not match /$regex/"; echo "$out" | tail -8; return
-  fi
-  ok "$name"
-}
 
 tiny=$src/tests/data/sweeps/tiny_product.yaml
 out=$work/tiny
@@ -159,5 +139,4 @@ expect own_comment 0 '1 cases, 0 to run \(1 completed before\)' -- "$surge" swee
 sed -i 's/density: 1000/density: 1100/' "$work/own.yaml"
 expect own_changed 0 'case_000_v=1 \[outdated\]' -- "$surge" sweep "$work/own_sweep.yaml" --out "$work/own" --dry-run
 
-echo "$pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish
