@@ -41,8 +41,8 @@ parameters:
   wc: [1, 2.5, 6]
   materials.sand.friction_angle_deg: [10, 30]
 threads_per_case: 2
-)", "sweeps/col.yaml", "/work/sweeps");
-  EXPECT_EQ(s.base, "/work/scenes/x.yaml");
+)", "sweeps/col.yaml", "/data/study/sweeps");
+  EXPECT_EQ(s.base, "/data/study/scenes/x.yaml");
   EXPECT_EQ(s.out, "results/col");
   EXPECT_EQ(s.mode, SweepMode::kProduct);
   EXPECT_EQ(s.threads_per_case, 2);
@@ -61,13 +61,13 @@ threads_per_case: 2
 TEST(SweepFile, ListValuesAndIndexedPathsMakeReadableNames) {
   const SweepSpec s = ParseSweepText(R"(
 base: a.yaml
-out: /tmp/o
+out: /data/out
 parameters:
   bodies.0.velocity: [[1, 0], [2, 0.5]]
   obstacles.0.shape.box.max.2: [3]
 )", "s.yaml", "d");
   ASSERT_EQ(s.cases.size(), 2u);
-  EXPECT_EQ(s.out, "/tmp/o");
+  EXPECT_EQ(s.out, "/data/out");
   EXPECT_EQ(s.cases[1].name, "case_001_velocity=2_0.5_max2=3");
   EXPECT_EQ(s.cases[1].values[0], "[2, 0.5]");
   EXPECT_EQ(Texts(s.cases[1])[0], "bodies.0.velocity=[2, 0.5]");
