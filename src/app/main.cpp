@@ -144,6 +144,14 @@ int Main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "terminal", "plain", "quiet"}));
   run->add_flag("--quiet,-q", quiet, "Only errors and the summary");
   run->add_flag("--verbose,-v", verbose, "Debug log messages");
+  bool force = false;
+  std::string restart;
+  int64_t stop_at_step = -1;
+  run->add_flag("--force", force, "Overwrite an existing result in the results folder");
+  run->add_option("--restart", restart,
+                  "Continue the run from a checkpoint (<out>/checkpoints/<name>_step_N.h5)");
+  // Testing only (tests/regression/restart_test.sh): stop as on Ctrl-C after this step.
+  run->add_option("--stop-at-step", stop_at_step, "")->group("")->check(CLI::NonNegativeNumber);
 
   CLI::App* check = app.add_subcommand("check", "Validate a scene and estimate its cost");
   check->add_option("scene", scene_path, "Scene file (YAML)")->required();
@@ -173,6 +181,13 @@ int Main(int argc, char** argv) {
     LoadedScene scene = LoadScene(scene_path, overrides);
     RunOptions options;
     options.out_dir = out_dir.empty() ? "results/" + scene.model.name : out_dir;
+    // A restart continues the result next to its checkpoint (<out>/checkpoints/...).
+    const std::filesystem::path checkpoint_dir = std::filesystem::path(restart).parent_path();
+    if (out_dir.empty() && !restart.empty() && checkpoint_dir.filename() == "checkpoints")
+      options.out_dir = checkpoint_dir.parent_path().empty() ? "." : checkpoint_dir.parent_path().string();
+    options.force = force;
+    options.restart = restart;
+    options.stop_at_step = stop_at_step;
     options.threads = threads;
     options.command_line = JoinArgs(argc, argv);
     options.progress = quiet                    ? ProgressMode::kQuiet
@@ -187,6 +202,9 @@ int Main(int argc, char** argv) {
     PrintSummary(scene, summary);
     return summary.exit_code;
   } catch (const SceneError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const RunRefused& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {

@@ -23,6 +23,7 @@
 #include "app/forces_command.h"
 #include "core/log.h"
 #include "grid/sparse_grid.h"
+#include "io/checkpoint.h"
 #include "io/results_writer.h"
 #include "scene/scene.h"
 #include "step/stages.h"
@@ -127,6 +128,61 @@ void WriteSummaryJson(const std::string& out_dir, RunSummary& summary) {
   }
 }
 
+// The checkpoints of the run in `out_dir` whose file names sort after `after` (later steps),
+// or all of them when `after` is "".
+void RemoveCheckpoints(const std::string& out_dir, const std::string& name,
+                       const std::string& after) {
+  for (const std::string& path : ListCheckpoints(out_dir, name)) {
+    if (!after.empty() && std::filesystem::path(path).filename().string() <= after) continue;
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+    Log(LogLevel::kDebug, "removed checkpoint " + path);
+  }
+}
+
+// Refuses a new run over an existing result unless options.force, and clears the old result's
+// checkpoints (they would continue a run that is being overwritten).
+void PrepareNewRun(const Model& model, const RunOptions& options) {
+  const std::string h5 = (std::filesystem::path(options.out_dir) / (model.name + ".h5")).string();
+  std::error_code ec;
+  if (std::filesystem::exists(h5, ec) && !options.force) {
+    const std::vector<std::string> checkpoints = ListCheckpoints(options.out_dir, model.name);
+    throw RunRefused("'" + h5 + "' exists: pass --force to overwrite it" +
+                     (checkpoints.empty()
+                          ? std::string(", or --out to write elsewhere")
+                          : ", --out to write elsewhere, or --restart " + checkpoints.back() +
+                                " to continue it"));
+  }
+  RemoveCheckpoints(options.out_dir, model.name, "");
+}
+
+// Reads options.restart and checks that it was written from this scene with these overrides.
+Checkpoint ReadMatchingCheckpoint(const LoadedScene& scene, const RunOptions& options) {
+  Checkpoint c;
+  try {
+    c = ReadCheckpoint(options.restart);
+  } catch (const IoError& e) {
+    throw RunRefused(std::string("cannot restart: ") + e.what());
+  }
+  const std::string hash = SceneHash(scene.text);
+  if (c.scene_hash != hash) {
+    throw RunRefused("checkpoint '" + options.restart + "' was written from another scene ('" +
+                     c.scene_path + "', hash " + c.scene_hash + ") than '" + scene.path +
+                     "' (hash " + hash + "); restart with the scene file it was written from");
+  }
+  if (c.resolved_hash != SceneHash(scene.resolved_yaml)) {
+    throw RunRefused("checkpoint '" + options.restart + "' was written from '" + scene.path +
+                     "' with other --set overrides (resolved scene hash " + c.resolved_hash +
+                     ", now " + SceneHash(scene.resolved_yaml) +
+                     "); restart with the same --set options as the interrupted run");
+  }
+  if (c.name != scene.model.name) {
+    throw RunRefused("checkpoint '" + options.restart + "' belongs to the run '" + c.name +
+                     "', not '" + scene.model.name + "'");
+  }
+  return c;
+}
+
 }  // namespace
 
 RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
@@ -135,6 +191,16 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   const int threads = options.threads > 0 ? options.threads
                                           : int(std::max(1u, std::thread::hardware_concurrency()));
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+
+  const bool restart = !options.restart.empty();
+  Checkpoint resume;
+  if (restart) {
+    resume = ReadMatchingCheckpoint(scene, options);
+    state = std::move(resume.state);
+    resume.state = State{};
+  } else {
+    PrepareNewRun(model, options);
+  }
 
   RunMetadata meta;
   meta.scene_path = scene.path;
@@ -145,11 +211,17 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   meta.command_line = options.command_line;
   meta.start_time_utc = UtcNow();
   meta.threads = threads;
-  ResultsWriter writer(options.out_dir, model.name, meta, model);
+  // A restart reopens the result and cuts it back to the checkpoint (ResultsWriter).
+  std::unique_ptr<ResultsWriter> writer_owner =
+      restart ? std::make_unique<ResultsWriter>(options.out_dir, model.name, model, resume.result)
+              : std::make_unique<ResultsWriter>(options.out_dir, model.name, meta, model);
+  ResultsWriter& writer = *writer_owner;
 
   RunSummary summary;
   const Pipeline pipeline = MakePipeline(model);
   Workspace work;
+  for (const RigidBodyState& b : resume.bullet)
+    work.rigid_restart.push_back({b.position, b.rotation, b.velocity, b.angular_velocity});
   StepReport report;
   Progress progress(options.progress, model.time.end);
 
@@ -165,7 +237,8 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
     }
   };
 
-  if (model.output.energy) writer.AppendEnergy(ComputeEnergy(model, state));
+  // The state at t = 0 (a restart has it in the result already).
+  if (model.output.energy && !restart) writer.AppendEnergy(ComputeEnergy(model, state));
   // Reaction forces on the domain walls and every obstacle, logged every step (DESIGN §7).
   const std::vector<ForceChannel> channels = ForceChannels(model);
   if (!channels.empty()) writer.BeginForces(channels);
@@ -173,8 +246,63 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   const bool rigid = !state.rigid.empty();
   if (rigid) writer.BeginRigid(RigidBodyNames(model));
   ContactReport forces;
-  write_snapshot();
+  if (!restart) write_snapshot();
   Real next_output = model.output.every > 0 ? model.output.every : model.time.end;
+  // Periodic checkpoints every output.checkpoint_every of simulated time (0: none).
+  const Real checkpoint_every = model.output.checkpoint_every;
+  Real next_checkpoint = checkpoint_every > 0 ? checkpoint_every : 0;
+  if (restart) {
+    next_output = resume.next_output;
+    next_checkpoint = resume.next_checkpoint;
+    // Checkpoints after this one belong to the part of the run that is being redone.
+    RemoveCheckpoints(options.out_dir, model.name,
+                      std::filesystem::path(CheckpointPath(options.out_dir, model.name, state.step))
+                          .filename()
+                          .string());
+    LogInfo(fmt::format("continuing from {} at t = {:.6g} s, step {}", options.restart,
+                        state.time, state.step));
+  }
+  // Writes a checkpoint of the state after the last completed step (docs/results-format.md,
+  // "Checkpoints") and keeps the newest output.checkpoints_keep. A failure is a warning: the
+  // run and its results go on.
+  auto write_checkpoint = [&]() {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string path = CheckpointPath(options.out_dir, model.name, state.step);
+    Checkpoint c;
+    c.result = writer.Flush();
+    c.next_output = next_output;
+    c.next_checkpoint = next_checkpoint;
+    c.name = model.name;
+    c.scene_path = scene.path;
+    c.scene_text = scene.text;
+    c.resolved_yaml = scene.resolved_yaml;
+    c.version = SURGE_VERSION;
+    c.git_hash = SURGE_GIT_HASH;
+    if (work.rigid_world) {
+      for (const int h : work.rigid_handle) {
+        const RigidWorld::BodyState b = work.rigid_world->State(h);
+        c.bullet.push_back({b.position, b.rotation, b.velocity, b.angular_velocity});
+      }
+    }
+    c.state = std::move(state);  // written in place: no copy of the particles
+    try {
+      WriteCheckpoint(path, c);
+    } catch (const std::exception& e) {
+      state = std::move(c.state);
+      LogWarn(std::string("checkpoint not written: ") + e.what());
+      return;
+    }
+    state = std::move(c.state);
+    const std::vector<std::string> all = ListCheckpoints(options.out_dir, model.name);
+    for (size_t k = 0; k + size_t(model.output.checkpoints_keep) < all.size(); ++k) {
+      std::error_code ec;
+      std::filesystem::remove(all[k], ec);
+    }
+    std::error_code ec;
+    const double mb = double(std::filesystem::file_size(path, ec)) / 1e6;
+    LogInfo(fmt::format("checkpoint {} ({:.1f} MB, {:.2f} s)", path, ec ? 0.0 : mb,
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+  };
   const auto start = std::chrono::steady_clock::now();
   double particle_steps = 0;
   const Real end_tolerance = 1e-12 * model.time.end;
@@ -206,11 +334,18 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
       write_snapshot();
       while (next_output <= state.time + end_tolerance) next_output += model.output.every;
     }
+    const bool interrupted =
+        g_interrupted.load() || (options.stop_at_step >= 0 && state.step >= options.stop_at_step);
+    if (checkpoint_every > 0 && state.time >= next_checkpoint - end_tolerance && !done) {
+      while (next_checkpoint <= state.time + end_tolerance) next_checkpoint += checkpoint_every;
+      if (!interrupted) write_checkpoint();
+    }
     progress.Update(state.time, state.step, state.particles.size());
-    if (g_interrupted.load()) {
+    if (interrupted) {
       summary.exit_code = kExitInterrupted;
       summary.exit_status = "interrupted at t = " + fmt::format("{:.6g}", state.time) + " s";
-      LogWarn("interrupted: finishing the current step and flushing the results");
+      LogWarn("interrupted: finishing the current step, writing a checkpoint and flushing the results");
+      if (!done) write_checkpoint();
       break;
     }
   }

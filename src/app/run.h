@@ -2,6 +2,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,17 @@ struct RunOptions {
   int threads = 0;           // 0 = all cores
   ProgressMode progress = ProgressMode::kAuto;
   std::string command_line;  // recorded in the results
+  bool force = false;        // overwrite an existing result <out_dir>/<name>.h5
+  std::string restart;       // checkpoint to continue from (io/checkpoint.h); "" = a new run
+  // Testing (hidden --stop-at-step): once this many steps are completed, stop as on Ctrl-C
+  // (checkpoint, flush, exit 130). -1 = never.
+  int64_t stop_at_step = -1;
+};
+
+// A run refused before it starts for a reason the user can fix on the command line (an existing
+// result without --force, a checkpoint of another scene): exit code kExitBadInput.
+struct RunRefused : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 struct RunSummary {
@@ -49,6 +61,10 @@ struct RunSummary {
   std::vector<std::string> analysis_lines;
 };
 
+// Runs the scene into options.out_dir, or continues the run of options.restart there (the
+// result is cut back to the checkpoint and continued; docs/results-format.md, "Checkpoints").
+// Throws RunRefused for an existing result without options.force, and for a checkpoint whose
+// scene (text or --set overrides) is not `scene`.
 RunSummary RunScene(LoadedScene& scene, const RunOptions& options);
 
 // Prints the end-of-run summary (results location, steps, speed, wall forces, energies).

@@ -254,9 +254,11 @@ class Runner {
     record.status = "running";
     WriteSweepCaseRecord((fs::path(v.dir) / "case.yaml").string(), record);
 
+    // --force: the sweep decided that this case runs (again); an older result in its folder
+    // (failed, interrupted, outdated) is replaced.
     std::vector<std::string> args = {exe_, "run", Absolute(spec_.base), "--out", v.dir,
                                      "--threads", std::to_string(spec_.threads_per_case),
-                                     "--progress", "quiet"};
+                                     "--progress", "quiet", "--force"};
     for (const std::string& o : record.overrides) {
       args.push_back("--set");
       args.push_back(o);

@@ -76,6 +76,23 @@ class ForceSummary {
   }
   int64_t samples() const { return samples_; }
 
+  // Continues from a summary saved in a checkpoint (io/checkpoint.h): every structure's running
+  // peaks and impulses and the number of samples so far, as structure() and samples() gave them.
+  // Pre: `peaks` has one entry per channel with one face entry per channel face.
+  void Restore(const std::vector<StructurePeak>& peaks, int64_t samples) {
+    SURGE_CHECK(peaks.size() == channels_.size(),
+                "checkpoint has " + std::to_string(peaks.size()) + " force summaries, the force channels " +
+                    std::to_string(channels_.size()));
+    for (size_t s = 0; s < channels_.size(); ++s) {
+      SURGE_CHECK(peaks[s].faces.size() == channels_[s].faces.size(),
+                  "checkpoint summary of '" + channels_[s].name + "' has " +
+                      std::to_string(peaks[s].faces.size()) + " faces, its channel has " +
+                      std::to_string(channels_[s].faces.size()));
+    }
+    structures_ = peaks;
+    samples_ = samples;
+  }
+
  private:
   void Accumulate(Real time, Real dt, const Vec3& force, Real contact_area, ForcePeak& out) {
     const Real magnitude = force.norm();

@@ -74,8 +74,15 @@ hid_t StringType(const std::string& value) {
   return type;
 }
 
+// An attribute of that name is replaced (a restarted run rewrites what Close wrote before).
+void DeleteAttrIfAny(hid_t obj, const char* name, const std::string& path) {
+  if (H5Aexists(obj, name) > 0)
+    Require(H5Adelete(obj, name) >= 0, std::string("replace attribute ") + name, path);
+}
+
 void WriteStringAttr(hid_t obj, const char* name, const std::string& value,
                      const std::string& path) {
+  DeleteAttrIfAny(obj, name, path);
   Handle type(StringType(value), H5Tclose);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   Handle attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
@@ -87,6 +94,7 @@ void WriteStringAttr(hid_t obj, const char* name, const std::string& value,
 
 template <typename T>
 void WriteScalarAttr(hid_t obj, const char* name, hid_t type, T value, const std::string& path) {
+  DeleteAttrIfAny(obj, name, path);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   Handle attr(H5Acreate2(obj, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   Require(attr.ok() && H5Awrite(attr.get(), type, &value) >= 0,
@@ -260,7 +268,53 @@ void AppendSeries(hid_t loc, const char* name, hid_t mem_type, const void* data,
           std::string("append rows to ") + name, path);
 }
 
+// Cuts an extendible dataset back to its first `rows` rows (a restart discards what the
+// interrupted run wrote after its checkpoint). Throws IoError when it has fewer.
+void TruncateSeries(hid_t loc, const std::string& name, hsize_t rows, const std::string& path) {
+  Handle ds(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
+  Require(ds.ok(), "open dataset " + name, path);
+  Handle space(H5Dget_space(ds.get()), H5Sclose);
+  hsize_t dims[2] = {0, 0};
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  Require(rank >= 1 && rank <= 2 && H5Sget_simple_extent_dims(space.get(), dims, nullptr) >= 0,
+          "read the shape of " + name, path);
+  if (dims[0] < rows) {
+    throw IoError("'" + path + "': " + name + " has " + std::to_string(dims[0]) +
+                  " rows, fewer than the checkpoint's " + std::to_string(rows) +
+                  " (the result is not the one the checkpoint was written with)");
+  }
+  dims[0] = rows;
+  Require(H5Dset_extent(ds.get(), dims) >= 0, "truncate " + name, path);
+}
+
+// Keeps the header and the first `rows` rows of a CSV series and opens it for appending.
+// Throws IoError when the file is missing or has fewer rows.
+FILE* TruncateCsv(const std::string& path, int64_t rows) {
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw IoError("cannot open '" + path + "' to continue it: " + std::strerror(errno));
+  int64_t lines = 0;
+  long keep = 0;
+  for (int c; lines < rows + 1 && (c = std::fgetc(f)) != EOF;) {
+    if (c == '\n') {
+      ++lines;
+      keep = std::ftell(f);
+    }
+  }
+  std::fclose(f);
+  if (lines < rows + 1) {
+    throw IoError("'" + path + "' has " + std::to_string(std::max<int64_t>(lines - 1, 0)) +
+                  " rows, fewer than the checkpoint's " + std::to_string(rows));
+  }
+  std::error_code ec;
+  fs::resize_file(path, uintmax_t(keep), ec);
+  if (ec) throw IoError("cannot truncate '" + path + "': " + ec.message());
+  f = std::fopen(path.c_str(), "a");
+  if (!f) throw IoError("cannot open '" + path + "' to continue it: " + std::strerror(errno));
+  return f;
+}
+
 void WriteVectorAttr(hid_t obj, const char* name, const Vec3& value, const std::string& path) {
+  DeleteAttrIfAny(obj, name, path);
   const hsize_t three = 3;
   Handle space(H5Screate_simple(1, &three, nullptr), H5Sclose);
   Handle attr(H5Acreate2(obj, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
@@ -394,6 +448,9 @@ struct ResultsWriter::Impl {
   hsize_t rigid_rows = 0;
   std::vector<std::string> rigid_csv_paths;
   std::vector<FILE*> rigid_csv;
+  // A restart (the reopening constructor): BeginForces and BeginRigid truncate and continue.
+  bool resuming = false;
+  ResultPosition resume;
 
   Impl() { energy_sets.fill(-1); }
   ~Impl() {
@@ -607,6 +664,9 @@ ResultsWriter::ResultsWriter(const std::string& out_dir, const std::string& name
                              const RunMetadata& meta, const Model& model)
     : impl_(std::make_unique<Impl>()) {
   Impl& I = *impl_;
+  if (!IsSafeName(name))
+    throw IoError("result name '" + name + "' is empty or not [A-Za-z0-9_-]+ (it names files in '" +
+                  out_dir + "')");
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec || !fs::is_directory(out_dir)) {
@@ -663,6 +723,97 @@ ResultsWriter::ResultsWriter(const std::string& out_dir, const std::string& name
   }
   I.OpenHandles();
   I.Commit();
+}
+
+ResultsWriter::ResultsWriter(const std::string& out_dir, const std::string& name,
+                             const Model& model, const ResultPosition& resume)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& I = *impl_;
+  if (!IsSafeName(name))
+    throw IoError("result name '" + name + "' is empty or not [A-Za-z0-9_-]+ (it names files in '" +
+                  out_dir + "')");
+  I.out_dir = out_dir;
+  I.dim = model.dim;
+  I.h5 = (fs::path(out_dir) / (name + ".h5")).string();
+  I.xmf = (fs::path(out_dir) / (name + ".xmf")).string();
+  I.resuming = true;
+  I.resume = resume;
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  std::error_code ec;
+  if (!fs::is_regular_file(I.h5, ec) || H5Fis_hdf5(I.h5.c_str()) <= 0) {
+    throw IoError("cannot continue '" + I.h5 +
+                  "': no such HDF5 file (a restart continues the result in the results folder the "
+                  "checkpoint was written for; give it with --out)");
+  }
+  I.fapl = H5Pcreate(H5P_FILE_ACCESS);
+  ConfigureFileAccess(I.fapl, I.h5);
+  I.file = H5Fopen(I.h5.c_str(), H5F_ACC_RDWR, I.fapl);
+  Require(I.file >= 0, "open the file to continue it", I.h5);
+  if (H5Lexists(I.file, "metadata", H5P_DEFAULT) <= 0 ||
+      H5Lexists(I.file, "snapshots", H5P_DEFAULT) <= 0 ||
+      H5Lexists(I.file, "energy", H5P_DEFAULT) <= 0) {
+    throw IoError("cannot continue '" + I.h5 + "': not a Surge result");
+  }
+  // Close writes /timing; the continued run writes it again at its end.
+  if (H5Lexists(I.file, "timing", H5P_DEFAULT) > 0)
+    Require(H5Ldelete(I.file, "timing", H5P_DEFAULT) >= 0, "remove /timing", I.h5);
+  I.OpenHandles();
+  // Snapshots 000000, 000001, ... : the checkpoint's first `snapshots` stay (and are listed in
+  // the .xmf again), later ones are unlinked (their space is not reused: file space strategy
+  // NONE, see "Crash safety").
+  for (int k = 0;; ++k) {
+    char sn[16];
+    std::snprintf(sn, sizeof sn, "%06d", k);
+    if (H5Lexists(I.snapshots, sn, H5P_DEFAULT) <= 0) break;
+    if (k >= resume.snapshots) {
+      Require(H5Ldelete(I.snapshots, sn, H5P_DEFAULT) >= 0, std::string("remove snapshot ") + sn,
+              I.h5);
+      continue;
+    }
+    Handle g(H5Gopen2(I.snapshots, sn, H5P_DEFAULT), H5Gclose);
+    Require(g.ok(), std::string("open snapshot ") + sn, I.h5);
+    double time = 0;
+    Handle attr(H5Aopen(g.get(), "time", H5P_DEFAULT), H5Aclose);
+    Require(attr.ok() && H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &time) >= 0,
+            std::string("read the time of snapshot ") + sn, I.h5);
+    Handle ds(H5Dopen2(g.get(), "position", H5P_DEFAULT), H5Dclose);
+    Require(ds.ok(), std::string("open snapshot ") + sn + "/position", I.h5);
+    Handle space(H5Dget_space(ds.get()), H5Sclose);
+    hsize_t dims[2] = {0, 0};
+    Require(H5Sget_simple_extent_dims(space.get(), dims, nullptr) >= 0,
+            std::string("read snapshot ") + sn + "/position", I.h5);
+    I.written.push_back(XdmfSnapshot{std::string("/snapshots/") + sn, time, size_t(dims[0])});
+  }
+  if (int(I.written.size()) != resume.snapshots) {
+    throw IoError("cannot continue '" + I.h5 + "': it has " + std::to_string(I.written.size()) +
+                  " snapshots, fewer than the checkpoint's " + std::to_string(resume.snapshots));
+  }
+  for (int c = 0; c < kEnergyColumns; ++c)
+    TruncateSeries(I.energy, kEnergyNames[c], hsize_t(resume.energy_rows), I.h5);
+  I.energy_rows = hsize_t(resume.energy_rows);
+  I.Commit();
+  WriteXdmf(I.xmf, fs::path(I.h5).filename().string(), I.written);
+}
+
+ResultPosition ResultsWriter::Flush() {
+  Impl& I = *impl_;
+  if (I.closed) throw IoError("Flush after Close on '" + I.h5 + "'");
+  I.WriteEnergyRows();
+  I.WriteForceRows();
+  I.WriteRigidRows();
+  I.Commit();
+  I.WriteForceCsv();
+  I.WriteRigidCsv();
+  ResultPosition p;
+  p.snapshots = int(I.written.size());
+  p.energy_rows = int64_t(I.energy_rows);
+  p.force_rows = int64_t(I.force_rows);
+  p.rigid_rows = int64_t(I.rigid_rows);
+  if (I.forces_begun) {
+    for (size_t s = 0; s < I.summary.size(); ++s) p.force_peaks.push_back(I.summary.structure(s));
+    p.force_samples = I.summary.samples();
+  }
+  return p;
 }
 
 ResultsWriter::~ResultsWriter() {
@@ -783,7 +934,24 @@ void ResultsWriter::BeginForces(const std::vector<ForceChannel>& channels) {
   const char* force_units = plane ? "N/m" : "N";
   const char* torque_units = plane ? "N m/m" : "N m";
   const char* area_units = plane ? "m^2/m" : "m^2";
-  {  // groups are closed before Commit closes the file
+  if (I.resuming) {  // a restart: the series exist; cut them back to the checkpoint's rows
+    const hsize_t rows = hsize_t(I.resume.force_rows);
+    Handle forces(H5Gopen2(I.file, "forces", H5P_DEFAULT), H5Gclose);
+    Require(forces.ok(), "open group /forces", I.h5);
+    for (const ForceChannel& c : channels) {
+      Handle g(H5Gopen2(forces.get(), c.name.c_str(), H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "open group /forces/" + c.name, I.h5);
+      for (const char* series : {"time", "step", "dt", "force", "torque", "contact_area",
+                                 "wetted_height", "max_nodal_force", "contact_nodes"})
+        TruncateSeries(g.get(), series, rows, I.h5);
+      for (const std::string& f : c.faces) {
+        for (const char* series : {"force", "contact_area", "contact_nodes"})
+          TruncateSeries(g.get(), "faces/" + f + "/" + series, rows, I.h5);
+      }
+    }
+    I.force_rows = rows;
+    I.summary.Restore(I.resume.force_peaks, I.resume.force_samples);
+  } else {  // groups are closed before Commit closes the file
     Handle forces(H5Gcreate2(I.file, "forces", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     Require(forces.ok(), "create group /forces", I.h5);
     std::vector<std::string> all;
@@ -819,6 +987,11 @@ void ResultsWriter::BeginForces(const std::vector<ForceChannel>& channels) {
 
   for (const ForceChannel& c : channels) {
     const std::string path = forces_csv_path(c.name);
+    if (I.resuming) {
+      I.csv.push_back(TruncateCsv(path, I.resume.force_rows));
+      I.csv_paths.push_back(path);
+      continue;
+    }
     FILE* f = std::fopen(path.c_str(), "w");
     if (!f) throw IoError("cannot create '" + path + "': " + std::strerror(errno));
     I.csv.push_back(f);
@@ -867,7 +1040,18 @@ void ResultsWriter::BeginRigid(const std::vector<std::string>& names) {
   I.rigid_begun = true;
   I.rigid_names = names;
   I.rigid_pending.assign(names.size(), RigidColumns{});
-  {  // groups are closed before Commit closes the file
+  if (I.resuming) {  // a restart: the series exist; cut them back to the checkpoint's rows
+    const hsize_t rows = hsize_t(I.resume.rigid_rows);
+    for (const std::string& name : names) {
+      const std::string group = "/rigid/" + name;
+      Handle g(H5Gopen2(I.file, group.c_str(), H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "open group " + group, I.h5);
+      for (const char* series :
+           {"time", "step", "position", "rotation", "velocity", "angular_velocity"})
+        TruncateSeries(g.get(), series, rows, I.h5);
+    }
+    I.rigid_rows = rows;
+  } else {  // groups are closed before Commit closes the file
     Handle rigid(H5Gcreate2(I.file, "rigid", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     Require(rigid.ok(), "create group /rigid", I.h5);
     WriteStringAttr(rigid.get(), "bodies", Join(names), I.h5);
@@ -887,6 +1071,11 @@ void ResultsWriter::BeginRigid(const std::vector<std::string>& names) {
 
   for (const std::string& name : names) {
     const std::string path = rigid_csv_path(name);
+    if (I.resuming) {
+      I.rigid_csv.push_back(TruncateCsv(path, I.resume.rigid_rows));
+      I.rigid_csv_paths.push_back(path);
+      continue;
+    }
     FILE* f = std::fopen(path.c_str(), "w");
     if (!f) throw IoError("cannot create '" + path + "': " + std::strerror(errno));
     I.rigid_csv.push_back(f);

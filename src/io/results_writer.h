@@ -35,12 +35,31 @@ struct RunMetadata {
   int threads = 1;
 };
 
+// Where a result stood when a checkpoint was taken (io/checkpoint.h, ResultsWriter::Flush): what
+// a restart truncates the result to before it continues.
+struct ResultPosition {
+  int snapshots = 0;        // snapshot groups /snapshots/000000 ... kept
+  int64_t energy_rows = 0;  // rows of every /energy column
+  int64_t force_rows = 0;   // rows of every /forces series and of every forces_<name>.csv
+  int64_t rigid_rows = 0;   // rows of every /rigid series and of every rigid_<name>.csv
+  std::vector<StructurePeak> force_peaks;  // ForceSummary::structure(s) for every channel
+  int64_t force_samples = 0;               // ForceSummary::samples()
+};
+
 class ResultsWriter {
  public:
   // Creates out_dir if needed and the .h5 file (truncating an old one). Throws IoError naming
-  // the path on failure.
+  // the path on failure, and for a name outside [A-Za-z0-9_-]+ (results stay inside out_dir).
   ResultsWriter(const std::string& out_dir, const std::string& name, const RunMetadata& meta,
                 const Model& model);
+  // Reopens the result <out_dir>/<name>.h5 of an interrupted run to continue it from a checkpoint
+  // (`surge run --restart`): snapshots from `resume.snapshots` on, the /energy rows from
+  // `resume.energy_rows` on and /timing are removed, and the .xmf is rewritten for the snapshots
+  // kept; BeginForces and BeginRigid then truncate the force and rigid series (HDF5 and CSV) to
+  // the checkpoint's rows and continue its force summary instead of starting new ones. Throws
+  // IoError naming the file when it is missing, not a Surge result, or shorter than the checkpoint.
+  ResultsWriter(const std::string& out_dir, const std::string& name, const Model& model,
+                const ResultPosition& resume);
   ~ResultsWriter();  // closes the file if Close was not called; never throws
   ResultsWriter(const ResultsWriter&) = delete;
   ResultsWriter& operator=(const ResultsWriter&) = delete;
@@ -74,6 +93,9 @@ class ResultsWriter {
   // whenever 1000 rows are pending, and on Close).
   // Pre: BeginRigid was called with bodies.size() names (else std::logic_error).
   void AppendRigid(Real time, int64_t step, const std::vector<RigidBodyState>& bodies);
+  // Writes every pending row (HDF5, flushed, and the CSV files) and returns where the result
+  // stands now: what a checkpoint taken at this moment records.
+  ResultPosition Flush();
   // Writes the pending rows, the force summary, stage timings and the exit status, then closes
   // the files.
   void Close(const StageSeconds& stage_seconds, int64_t steps, double wall_seconds,

@@ -347,6 +347,8 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   BuildAnalysis(spec, model);
 
   // Seed every body; ids follow seeding order (body by body).
+  model.output.checkpoint_every = spec.output.checkpoint_every;
+  model.output.checkpoints_keep = spec.output.checkpoints_keep;
   std::vector<SeededBody> seeded;
   std::vector<int64_t> first_id;
   double total = 0;

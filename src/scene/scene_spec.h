@@ -232,6 +232,8 @@ struct OutputSpec {
   bool energy = true;
 };
 
+  Real checkpoint_every = 0;  // [s] of simulated time; 0 = no periodic checkpoints
+  int checkpoints_keep = 3;   // newest periodic checkpoints kept
 // `analysis:` (docs/scene-reference.md): what `surge forces` and the end of `surge run` analyse.
 // `settings` holds the values as written (unset reference values stay unset); ResolveAnalysis
 // fills the defaults.

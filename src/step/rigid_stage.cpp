@@ -119,7 +119,7 @@ void BuildRigidWorld(const Model& m, const State& s, Workspace& w) {
     b.position = r.position - b.rotation * w.rigid_offset[k];
     b.angular_velocity = r.angular_velocity;
     b.velocity = r.velocity - r.angular_velocity.cross(r.position - b.position);
-    world.SetState(h, b);
+    world.SetState(h, k < w.rigid_restart.size() ? w.rigid_restart[k] : b);
   }
 }
 

@@ -29,3 +29,7 @@ struct Workspace {
 };
 
 }  // namespace surge
+  // Restart only (io/checkpoint.h): Bullet's own state of each dynamic body as the checkpoint
+  // saved it, by body; used once, when the Bullet world is built, instead of re-deriving it from
+  // State::rigid (which would round the centre of mass differently in the last bit).
+  std::vector<RigidWorld::BodyState> rigid_restart;

@@ -1,0 +1,453 @@
+// Checkpoint files (checkpoint.h; layout in docs/results-format.md, "Checkpoints"). Every array is
+// stored as the raw float64/int bytes of the State's vectors (no compression, no conversion), so
+// reading one back gives the State bitwise.
+#include "io/checkpoint.h"
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <type_traits>
+
+namespace surge {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kFormat = "surge-checkpoint";
+constexpr int kFormatVersion = 1;
+
+// The State's element types are stored as rows of doubles: no padding may hide in them.
+static_assert(sizeof(Vec3) == 3 * sizeof(double) && sizeof(Mat3) == 9 * sizeof(double),
+              "Eigen fixed-size types must be packed");
+static_assert(sizeof(History) == kHistorySlots * sizeof(double), "History must be packed");
+static_assert(std::is_same_v<Real, double>, "checkpoints store Real as float64");
+
+// Owns an hid_t and closes it with the matching H5*close (as in hdf5_writer.cpp).
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  hid_t get() const { return id_; }
+  bool ok() const { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+void Require(bool ok, const std::string& what, const std::string& path) {
+  if (!ok) throw IoError("checkpoint '" + path + "': cannot " + what);
+}
+
+// --- writing ---
+
+void WriteString(hid_t loc, const char* name, const std::string& value, bool dataset,
+                 const std::string& path) {
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.get(), std::max<size_t>(value.size(), 1));
+  H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
+  H5Tset_cset(type.get(), H5T_CSET_UTF8);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  const std::string padded = value.empty() ? std::string(1, '\0') : value;
+  if (dataset) {
+    Handle ds(H5Dcreate2(loc, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+              H5Dclose);
+    Require(ds.ok() && H5Dwrite(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                                padded.data()) >= 0,
+            std::string("write ") + name, path);
+  } else {
+    Handle attr(H5Acreate2(loc, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+    Require(attr.ok() && H5Awrite(attr.get(), type.get(), padded.data()) >= 0,
+            std::string("write attribute ") + name, path);
+  }
+}
+
+template <typename T>
+void WriteScalar(hid_t loc, const char* name, hid_t file_type, hid_t mem_type, T value,
+                 const std::string& path) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attr(H5Acreate2(loc, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  Require(attr.ok() && H5Awrite(attr.get(), mem_type, &value) >= 0,
+          std::string("write attribute ") + name, path);
+}
+void WriteReal(hid_t loc, const char* name, Real v, const std::string& path) {
+  WriteScalar(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v, path);
+}
+void WriteInt(hid_t loc, const char* name, int64_t v, const std::string& path) {
+  WriteScalar(loc, name, H5T_STD_I64LE, H5T_NATIVE_INT64, v, path);
+}
+
+// rows x cols values (cols = 0: 1-D), contiguous.
+void WriteArray(hid_t loc, const char* name, hid_t file_type, hid_t mem_type, const void* data,
+                size_t rows, size_t cols, const std::string& path) {
+  const hsize_t dims[2] = {hsize_t(rows), hsize_t(cols)};
+  Handle space(H5Screate_simple(cols == 0 ? 1 : 2, dims, nullptr), H5Sclose);
+  Handle ds(H5Dcreate2(loc, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+            H5Dclose);
+  Require(ds.ok(), std::string("create ") + name, path);
+  if (rows > 0) {
+    Require(H5Dwrite(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0,
+            std::string("write ") + name, path);
+  }
+}
+void WriteDoubles(hid_t loc, const char* name, const void* data, size_t rows, size_t cols,
+                  const std::string& path) {
+  WriteArray(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data, rows, cols, path);
+}
+
+// A rigid body state as 18 doubles: position, rotation (column-major), velocity, angular velocity.
+constexpr size_t kRigidColumns = 18;
+std::vector<double> FlattenRigid(const std::vector<RigidBodyState>& bodies) {
+  std::vector<double> out;
+  for (const RigidBodyState& b : bodies) {
+    out.insert(out.end(), b.position.data(), b.position.data() + 3);
+    out.insert(out.end(), b.rotation.data(), b.rotation.data() + 9);
+    out.insert(out.end(), b.velocity.data(), b.velocity.data() + 3);
+    out.insert(out.end(), b.angular_velocity.data(), b.angular_velocity.data() + 3);
+  }
+  return out;
+}
+std::vector<RigidBodyState> UnflattenRigid(const std::vector<double>& v) {
+  std::vector<RigidBodyState> out(v.size() / kRigidColumns);
+  for (size_t k = 0; k < out.size(); ++k) {
+    const double* p = &v[k * kRigidColumns];
+    std::copy(p, p + 3, out[k].position.data());
+    std::copy(p + 3, p + 12, out[k].rotation.data());
+    std::copy(p + 12, p + 15, out[k].velocity.data());
+    std::copy(p + 15, p + 18, out[k].angular_velocity.data());
+  }
+  return out;
+}
+
+// A ForcePeak as 9 doubles: peak_force, peak_time, force_at_peak (3), impulse (3),
+// peak_contact_area.
+constexpr size_t kPeakColumns = 9;
+void PushPeak(std::vector<double>& out, const ForcePeak& p) {
+  out.push_back(p.peak_force);
+  out.push_back(p.peak_time);
+  out.insert(out.end(), p.force_at_peak.data(), p.force_at_peak.data() + 3);
+  out.insert(out.end(), p.impulse.data(), p.impulse.data() + 3);
+  out.push_back(p.peak_contact_area);
+}
+ForcePeak PopPeak(const double* p) {
+  ForcePeak f;
+  f.peak_force = p[0];
+  f.peak_time = p[1];
+  std::copy(p + 2, p + 5, f.force_at_peak.data());
+  std::copy(p + 5, p + 8, f.impulse.data());
+  f.peak_contact_area = p[8];
+  return f;
+}
+
+// --- reading ---
+
+std::string ReadString(hid_t loc, const char* name, bool dataset, const std::string& path) {
+  Handle obj(dataset ? H5Dopen2(loc, name, H5P_DEFAULT) : H5Aopen(loc, name, H5P_DEFAULT),
+             dataset ? H5Dclose : H5Aclose);
+  Require(obj.ok(), std::string("open ") + name, path);
+  Handle type(dataset ? H5Dget_type(obj.get()) : H5Aget_type(obj.get()), H5Tclose);
+  Require(type.ok() && H5Tget_class(type.get()) == H5T_STRING && H5Tis_variable_str(type.get()) <= 0,
+          std::string("read ") + name, path);
+  std::string out(H5Tget_size(type.get()), '\0');
+  const herr_t rc = dataset ? H5Dread(obj.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data())
+                            : H5Aread(obj.get(), type.get(), out.data());
+  Require(rc >= 0, std::string("read ") + name, path);
+  out.resize(std::strlen(out.c_str()));
+  return out;
+}
+
+template <typename T>
+T ReadScalar(hid_t loc, const char* name, hid_t mem_type, const std::string& path) {
+  Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose);
+  T value{};
+  Require(attr.ok() && H5Aread(attr.get(), mem_type, &value) >= 0,
+          std::string("read attribute ") + name, path);
+  return value;
+}
+Real ReadReal(hid_t loc, const char* name, const std::string& path) {
+  return ReadScalar<double>(loc, name, H5T_NATIVE_DOUBLE, path);
+}
+int64_t ReadInt(hid_t loc, const char* name, const std::string& path) {
+  return ReadScalar<int64_t>(loc, name, H5T_NATIVE_INT64, path);
+}
+
+// A rows x cols dataset (cols = 0: 1-D) into `out` (resized to rows elements of T, each
+// `cols` (or 1) values of mem_type). Throws when the shape is not rows x cols.
+template <typename T>
+void ReadArray(hid_t loc, const char* name, hid_t mem_type, size_t rows, size_t cols,
+               std::vector<T>& out, const std::string& path) {
+  Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
+  Require(ds.ok(), std::string("open ") + name, path);
+  Handle space(H5Dget_space(ds.get()), H5Sclose);
+  hsize_t dims[2] = {0, 0};
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  if (rank != (cols == 0 ? 1 : 2) || dims[0] != rows || (cols != 0 && dims[1] != cols)) {
+    throw IoError("checkpoint '" + path + "': " + name + " has the wrong shape (expected " +
+                  std::to_string(rows) + " rows" +
+                  (cols ? " x " + std::to_string(cols) : std::string()) + ")");
+  }
+  out.resize(rows);
+  if (rows > 0) {
+    Require(H5Dread(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) >= 0,
+            std::string("read ") + name, path);
+  }
+}
+
+// The number of rows of a dataset.
+size_t Rows(hid_t loc, const char* name, const std::string& path) {
+  Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
+  Require(ds.ok(), std::string("open ") + name, path);
+  Handle space(H5Dget_space(ds.get()), H5Sclose);
+  hsize_t dims[2] = {0, 0};
+  Require(H5Sget_simple_extent_dims(space.get(), dims, nullptr) >= 1, std::string("read ") + name,
+          path);
+  return size_t(dims[0]);
+}
+
+}  // namespace
+
+std::string SceneHash(const std::string& text) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a 64 offset basis and prime
+  for (unsigned char ch : text) {
+    h ^= ch;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string CheckpointPath(const std::string& out_dir, const std::string& name, int64_t step) {
+  char file[64];
+  std::snprintf(file, sizeof file, "_step_%09lld.h5", static_cast<long long>(step));
+  return (fs::path(out_dir) / "checkpoints" / (name + file)).string();
+}
+
+std::vector<std::string> ListCheckpoints(const std::string& out_dir, const std::string& name) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  const fs::path dir = fs::path(out_dir) / "checkpoints";
+  if (!fs::is_directory(dir, ec)) return out;
+  const std::string prefix = name + "_step_";
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string f = e.path().filename().string();
+    if (f.size() == prefix.size() + 12 && f.compare(0, prefix.size(), prefix) == 0 &&
+        f.compare(f.size() - 3, 3, ".h5") == 0 &&
+        std::all_of(f.begin() + long(prefix.size()), f.end() - 3,
+                    [](char c) { return c >= '0' && c <= '9'; })) {
+      out.push_back(e.path().string());
+    }
+  }
+  std::sort(out.begin(), out.end());  // fixed-width step numbers: name order is step order
+  return out;
+}
+
+void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
+  std::error_code ec;
+  const fs::path dir = fs::path(path).parent_path();
+  if (!dir.empty()) fs::create_directories(dir, ec);
+  if (ec) throw IoError("cannot create checkpoint folder '" + dir.string() + "': " + ec.message());
+  const std::string tmp = path + ".tmp";
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  {
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    Require(file.ok(), "create the file", tmp);
+    const hid_t f = file.get();
+    const State& s = c.state;
+    WriteString(f, "format", kFormat, false, tmp);
+    WriteInt(f, "format_version", kFormatVersion, tmp);
+    WriteString(f, "name", c.name, false, tmp);
+    WriteString(f, "version", c.version, false, tmp);
+    WriteString(f, "git_hash", c.git_hash, false, tmp);
+    WriteString(f, "scene_path", c.scene_path, false, tmp);
+    WriteString(f, "scene_hash", SceneHash(c.scene_text), false, tmp);
+    WriteString(f, "resolved_hash", SceneHash(c.resolved_yaml), false, tmp);
+    WriteReal(f, "time", s.time, tmp);
+    WriteInt(f, "step", s.step, tmp);
+    WriteReal(f, "dt", s.dt, tmp);
+    WriteInt(f, "particles_removed", s.particles_removed, tmp);
+    WriteReal(f, "wall_work", s.wall_work, tmp);
+    WriteReal(f, "next_output", c.next_output, tmp);
+    WriteReal(f, "next_checkpoint", c.next_checkpoint, tmp);
+    {
+      Handle g(H5Gcreate2(f, "metadata", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "create /metadata", tmp);
+      WriteString(g.get(), "scene", c.scene_text, true, tmp);
+      WriteString(g.get(), "resolved", c.resolved_yaml, true, tmp);
+    }
+    {
+      const Particles& P = s.particles;
+      const size_t n = P.size();
+      Handle g(H5Gcreate2(f, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "create /particles", tmp);
+      const hid_t l = g.get();
+      WriteDoubles(l, "x", P.x.data(), n, 3, tmp);
+      WriteDoubles(l, "v", P.v.data(), n, 3, tmp);
+      WriteDoubles(l, "C", P.C.data(), n, 9, tmp);
+      WriteDoubles(l, "F", P.F.data(), n, 9, tmp);
+      WriteDoubles(l, "stress", P.stress.data(), n, 9, tmp);
+      WriteDoubles(l, "strain", P.strain.data(), n, 9, tmp);
+      WriteDoubles(l, "elastic_b", P.elastic_b.data(), n, 9, tmp);
+      WriteDoubles(l, "history", P.history.data(), n, kHistorySlots, tmp);
+      WriteDoubles(l, "mass", P.mass.data(), n, 0, tmp);
+      WriteDoubles(l, "volume0", P.volume0.data(), n, 0, tmp);
+      WriteDoubles(l, "ext_force", P.ext_force.data(), n, 3, tmp);
+      WriteArray(l, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, P.material.data(), n, 0, tmp);
+      WriteArray(l, "body", H5T_STD_I32LE, H5T_NATIVE_INT32, P.body.data(), n, 0, tmp);
+      WriteArray(l, "id", H5T_STD_I64LE, H5T_NATIVE_INT64, P.id.data(), n, 0, tmp);
+    }
+    {
+      std::vector<int64_t> groups;
+      for (const MaterialGroup& m : s.groups) {
+        groups.push_back(m.material);
+        groups.push_back(int64_t(m.begin));
+        groups.push_back(int64_t(m.end));
+      }
+      WriteArray(f, "groups", H5T_STD_I64LE, H5T_NATIVE_INT64, groups.data(), s.groups.size(), 3,
+                 tmp);
+      WriteDoubles(f, "rigid", FlattenRigid(s.rigid).data(), s.rigid.size(), kRigidColumns, tmp);
+      WriteDoubles(f, "bullet", FlattenRigid(c.bullet).data(), c.bullet.size(), kRigidColumns, tmp);
+    }
+    {
+      const ResultPosition& r = c.result;
+      Handle g(H5Gcreate2(f, "result", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "create /result", tmp);
+      WriteInt(g.get(), "snapshots", r.snapshots, tmp);
+      WriteInt(g.get(), "energy_rows", r.energy_rows, tmp);
+      WriteInt(g.get(), "force_rows", r.force_rows, tmp);
+      WriteInt(g.get(), "rigid_rows", r.rigid_rows, tmp);
+      WriteInt(g.get(), "force_samples", r.force_samples, tmp);
+      // Per structure: its ForcePeak, peak_wetted_height, then one ForcePeak per face.
+      std::vector<double> peaks;
+      std::vector<int64_t> faces;
+      for (const StructurePeak& p : r.force_peaks) {
+        PushPeak(peaks, p);
+        peaks.push_back(p.peak_wetted_height);
+        for (const ForcePeak& face : p.faces) PushPeak(peaks, face);
+        faces.push_back(int64_t(p.faces.size()));
+      }
+      WriteDoubles(g.get(), "force_peaks", peaks.data(), peaks.size(), 0, tmp);
+      WriteArray(g.get(), "force_peak_faces", H5T_STD_I64LE, H5T_NATIVE_INT64, faces.data(),
+                 faces.size(), 0, tmp);
+    }
+    Require(H5Fflush(f, H5F_SCOPE_GLOBAL) >= 0, "flush the file", tmp);
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) throw IoError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+}
+
+Checkpoint ReadCheckpoint(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw IoError("checkpoint '" + path + "': no such file");
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  if (H5Fis_hdf5(path.c_str()) <= 0) throw IoError("checkpoint '" + path + "' is not an HDF5 file");
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  Require(file.ok(), "open the file", path);
+  const hid_t f = file.get();
+  if (H5Aexists(f, "format") <= 0 || ReadString(f, "format", false, path) != kFormat)
+    throw IoError("'" + path + "' is not a Surge checkpoint (no format = surge-checkpoint)");
+  const int64_t version = ReadInt(f, "format_version", path);
+  if (version != kFormatVersion) {
+    throw IoError("checkpoint '" + path + "' has format version " + std::to_string(version) +
+                  "; this surge reads version " + std::to_string(kFormatVersion));
+  }
+  Checkpoint c;
+  c.name = ReadString(f, "name", false, path);
+  c.version = ReadString(f, "version", false, path);
+  c.git_hash = ReadString(f, "git_hash", false, path);
+  c.scene_path = ReadString(f, "scene_path", false, path);
+  c.scene_hash = ReadString(f, "scene_hash", false, path);
+  c.resolved_hash = ReadString(f, "resolved_hash", false, path);
+  c.scene_text = ReadString(f, "metadata/scene", true, path);
+  c.resolved_yaml = ReadString(f, "metadata/resolved", true, path);
+  State& s = c.state;
+  s.time = ReadReal(f, "time", path);
+  s.step = ReadInt(f, "step", path);
+  s.dt = ReadReal(f, "dt", path);
+  s.particles_removed = ReadInt(f, "particles_removed", path);
+  s.wall_work = ReadReal(f, "wall_work", path);
+  c.next_output = ReadReal(f, "next_output", path);
+  c.next_checkpoint = ReadReal(f, "next_checkpoint", path);
+  {
+    Handle g(H5Gopen2(f, "particles", H5P_DEFAULT), H5Gclose);
+    Require(g.ok(), "open /particles", path);
+    const hid_t l = g.get();
+    Particles& P = s.particles;
+    const size_t n = Rows(l, "x", path);
+    const hid_t d = H5T_NATIVE_DOUBLE;
+    ReadArray(l, "x", d, n, 3, P.x, path);
+    ReadArray(l, "v", d, n, 3, P.v, path);
+    ReadArray(l, "C", d, n, 9, P.C, path);
+    ReadArray(l, "F", d, n, 9, P.F, path);
+    ReadArray(l, "stress", d, n, 9, P.stress, path);
+    ReadArray(l, "strain", d, n, 9, P.strain, path);
+    ReadArray(l, "elastic_b", d, n, 9, P.elastic_b, path);
+    ReadArray(l, "history", d, n, kHistorySlots, P.history, path);
+    ReadArray(l, "mass", d, n, 0, P.mass, path);
+    ReadArray(l, "volume0", d, n, 0, P.volume0, path);
+    ReadArray(l, "ext_force", d, n, 3, P.ext_force, path);
+    ReadArray(l, "material", H5T_NATIVE_INT32, n, 0, P.material, path);
+    ReadArray(l, "body", H5T_NATIVE_INT32, n, 0, P.body, path);
+    ReadArray(l, "id", H5T_NATIVE_INT64, n, 0, P.id, path);
+  }
+  {
+    std::vector<std::array<int64_t, 3>> groups;
+    ReadArray(f, "groups", H5T_NATIVE_INT64, Rows(f, "groups", path), 3, groups, path);
+    for (const auto& g : groups) {
+      if (g[1] < 0 || g[2] < g[1] || size_t(g[2]) > s.particles.size())
+        throw IoError("checkpoint '" + path + "': a material group lies outside the particles");
+      s.groups.push_back(MaterialGroup{int(g[0]), size_t(g[1]), size_t(g[2])});
+    }
+    const auto read_rigid = [&](const char* name) {
+      std::vector<std::array<double, kRigidColumns>> rows;
+      ReadArray(f, name, H5T_NATIVE_DOUBLE, Rows(f, name, path), kRigidColumns, rows, path);
+      std::vector<double> flat;
+      for (const auto& row : rows) flat.insert(flat.end(), row.begin(), row.end());
+      return UnflattenRigid(flat);
+    };
+    s.rigid = read_rigid("rigid");
+    c.bullet = read_rigid("bullet");
+  }
+  {
+    Handle g(H5Gopen2(f, "result", H5P_DEFAULT), H5Gclose);
+    Require(g.ok(), "open /result", path);
+    ResultPosition& r = c.result;
+    r.snapshots = int(ReadInt(g.get(), "snapshots", path));
+    r.energy_rows = ReadInt(g.get(), "energy_rows", path);
+    r.force_rows = ReadInt(g.get(), "force_rows", path);
+    r.rigid_rows = ReadInt(g.get(), "rigid_rows", path);
+    r.force_samples = ReadInt(g.get(), "force_samples", path);
+    std::vector<double> peaks;
+    std::vector<int64_t> faces;
+    ReadArray(g.get(), "force_peak_faces", H5T_NATIVE_INT64, Rows(g.get(), "force_peak_faces", path),
+              0, faces, path);
+    ReadArray(g.get(), "force_peaks", H5T_NATIVE_DOUBLE, Rows(g.get(), "force_peaks", path), 0,
+              peaks, path);
+    size_t at = 0;
+    for (int64_t nf : faces) {
+      const size_t need = kPeakColumns + 1 + size_t(std::max<int64_t>(nf, 0)) * kPeakColumns;
+      if (nf < 0 || at + need > peaks.size())
+        throw IoError("checkpoint '" + path + "': /result/force_peaks is too short");
+      StructurePeak p;
+      static_cast<ForcePeak&>(p) = PopPeak(&peaks[at]);
+      p.peak_wetted_height = peaks[at + kPeakColumns];
+      for (int64_t k = 0; k < nf; ++k)
+        p.faces.push_back(PopPeak(&peaks[at + kPeakColumns + 1 + size_t(k) * kPeakColumns]));
+      at += need;
+      r.force_peaks.push_back(std::move(p));
+    }
+  }
+  return c;
+}
+
+}  // namespace surge
