@@ -17,6 +17,7 @@
 #include "core/log.h"
 #include "grid/sparse_grid.h"
 #include "io/results_writer.h"
+#include "scene/memory_estimate.h"
 #include "scene/scene.h"
 #include "step/stages.h"
 #include "step/step.h"
@@ -58,8 +59,10 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
   ParticleToGrid(m, ctx, P, grid);
   const Real dt = NextTimeStep(m, scene.state);
   const double steps = dt > 0 ? m.time.end / dt : 0;
-  const double particle_bytes = double(P.size()) * (5 * 9 + 4 * 3 + 2) * 8;
-  const double grid_bytes = double(grid.block_count()) * kBlockNodes * (1 + 4 * 3) * 8;
+  // Memory at the first step (scene/memory_estimate.h; the run refuses a scene whose estimate
+  // exceeds the available memory before seeding it).
+  const MemoryEstimate memory =
+      EstimateMemory(double(P.size()), double(grid.block_count()), m.field_count);
   std::printf("scene      %s (%s)\n", m.name.c_str(), path.c_str());
   std::printf("dimension  %d-D%s, cell size %g m, %s, %s\n", m.dim,
               m.dim == 2 ? " plane strain" : "", m.dx, ShapeName(m.shape),
@@ -92,8 +95,11 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
                 : dt_viscous <= dt * 1.000001 ? "governs"
                                               : "not binding");
   }
-  std::printf("memory     about %.1f MB (particles %.1f MB, grid %.1f MB)\n",
-              (particle_bytes + grid_bytes) / 1e6, particle_bytes / 1e6, grid_bytes / 1e6);
+  std::printf("memory     about %s (particles %s: %.0f bytes each; grid %s: %.0f bytes a block), "
+              "%s available\n",
+              FormatBytes(memory.total()).c_str(), FormatBytes(memory.particle_bytes).c_str(),
+              BytesPerParticle(), FormatBytes(memory.grid_bytes).c_str(),
+              BytesPerBlock(m.field_count), FormatBytes(AvailableMemory()).c_str());
   for (const std::string& w : SceneWarnings(scene)) std::printf("warning    %s\n", w.c_str());
   std::printf("scene OK\n");
   return kExitOk;

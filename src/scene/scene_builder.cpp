@@ -18,6 +18,7 @@
 #include "core/log.h"
 #include "materials/update_stress.h"
 #include "mesh/mesh.h"
+#include "scene/memory_estimate.h"
 #include "scene/particle_sampling.h"
 #include "scene/scene_error.h"
 
@@ -45,6 +46,26 @@ std::string Point(const Vec3& x, int dim) {
   std::string s = "(";
   for (int a = 0; a < dim; ++a) s.append(a ? ", " : "").append(Num(x[a]));
   return s.append(")");
+}
+
+// Refuses the scene when a run of `particles` particles whose grid covers `box` (clipped to the
+// domain) needs more memory than the machine has available (memory_estimate.h). `qualifier`
+// ("at most ") says that the count is an upper bound.
+void CheckMemory(const SceneSpec& spec, double particles, Aabb box, int fields,
+                 const std::string& qualifier) {
+  box.min = box.min.cwiseMax(spec.domain.min);
+  box.max = box.max.cwiseMin(spec.domain.max);
+  const MemoryEstimate m = EstimateMemory(
+      particles, BlocksCovering(box.min, box.max, spec.grid.cell_size, spec.dimension), fields);
+  const double available = AvailableMemory();
+  if (m.total() <= available) return;
+  const SourceLoc& loc = spec.bodies.empty() ? SourceLoc{} : spec.bodies.front().loc;
+  Fail(loc, "bodies",
+       "the run needs about " + FormatBytes(m.total()) + " of memory (" + qualifier +
+           Num(std::round(particles)) + " particles x " + Num(BytesPerParticle()) + " bytes + " +
+           Num(m.grid_blocks) + " grid blocks x " + Num(BytesPerBlock(fields)) +
+           " bytes), more than the " + FormatBytes(available) +
+           " available on this machine; use a larger grid.cell_size or fewer particles_per_cell");
 }
 
 // Particles of one body, in seeding order.
@@ -344,11 +365,32 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   model.output.every = spec.output.every;
   model.output.vdb = spec.output.vdb;
   model.output.energy = spec.output.energy;
-  BuildAnalysis(spec, model);
-
-  // Seed every body; ids follow seeding order (body by body).
   model.output.checkpoint_every = spec.output.checkpoint_every;
   model.output.checkpoints_keep = spec.output.checkpoints_keep;
+  BuildAnalysis(spec, model);
+
+  // Memory (issue 9): refuse a scene that cannot fit before seeding allocates anything. The
+  // lattice points of each region's bounding box bound its particles from above (exactly for
+  // boxes); mesh regions are counted after seeding, below.
+  {
+    double particles = 0;
+    Aabb box{spec.domain.max, spec.domain.min};
+    for (const BodySpec& b : spec.bodies) {
+      if (std::holds_alternative<MeshRegion>(b.region)) continue;
+      const Aabb r = RegionBounds(b.region, nullptr);
+      const double c =
+          CountLatticePoints(r, spec.dimension, spec.grid.cell_size / b.particles_per_cell);
+      if (!(c <= kMaxCandidates)) continue;  // SeedBody refuses it with its own message
+      particles += c;
+      box.min = box.min.cwiseMin(r.min);
+      box.max = box.max.cwiseMax(r.max);
+    }
+    if (particles > 0) {
+      CheckMemory(spec, particles, box, model.field_count, "at most ");
+    }
+  }
+
+  // Seed every body; ids follow seeding order (body by body).
   std::vector<SeededBody> seeded;
   std::vector<int64_t> first_id;
   double total = 0;
@@ -361,6 +403,17 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
            "the scene has more than 2e8 particles (" + std::to_string(static_cast<long long>(total)) +
                " after body '" + spec.bodies[b].name + "')");
     }
+  }
+
+  {  // the exact count and bounding box before the particle arrays are allocated
+    Aabb box{spec.domain.max, spec.domain.min};
+    for (const SeededBody& s : seeded) {
+      for (const Vec3& x : s.x) {
+        box.min = box.min.cwiseMin(x);
+        box.max = box.max.cwiseMax(x);
+      }
+    }
+    CheckMemory(spec, total, box, model.field_count, "");
   }
 
   // Lay the particles out grouped by material, bodies in file order within a group: the same

@@ -85,6 +85,25 @@ fi
 expect check_obstacle_named_domain 2 'obstacles\[0\]\.name.*reserved' -- "$surge" check "$work/obstacles.yaml" --set "obstacles.0.name=domain"
 expect check_geostatic_ramp 0 "bodies\[0\] 'surge': starts with a geostatic stress while gravity_ramp" -- "$surge" check "$src/scenes/column_impact_3d.yaml" --set gravity_ramp=0.2
 expect check_cylinder_2d 2 'cylinder obstacles are 3-D only' -- "$surge" check "$work/obstacles.yaml" --set "obstacles.1.shape={cylinder: {base: [0.6, 0], top: [0.6, 0.5], radius: 0.05}}"
+# Memory (issue 9): surge check prints the estimate; a scene that needs more than the machine has
+# is refused before seeding (1.9e8 particles, about 176 GB: refused in 0.2 s using 51 MB), and
+# SURGE_MEMORY_LIMIT caps what surge takes as available.
+expect check_memory 0 'memory +about [0-9.]+ MB \(particles [0-9.]+ MB: [0-9]+ bytes each; grid [0-9.]+ MB: [0-9]+ bytes a block\), [0-9.]+ [GM]B available' -- "$surge" check "$src/scenes/two_disks_2d.yaml"
+cat > "$work/huge.yaml" <<'YAML'
+name: huge
+dimension: 3
+time: {end: 1.0}
+grid: {cell_size: 0.01}
+domain: {min: [0, 0, 0], max: [10, 10, 10]}
+materials:
+  m: {model: neo_hookean, density: 1000, bulk_modulus: 1.0e6, shear_modulus: 1.0e5}
+bodies:
+  - {name: b, material: m, region: {box: {min: [0, 0, 0], max: [5.7, 5.7, 5.7]}}, particles_per_cell: 1}
+YAML
+start=$(date +%s)
+expect memory_refused 2 'huge.yaml:9:5: bodies: the run needs about [0-9.]+ GB of memory \(at most 190109375 particles x [0-9]+ bytes \+ [0-9]+ grid blocks x [0-9]+ bytes\), more than the [0-9.]+ [GM]B available' -- "$surge" run "$work/huge.yaml" --out "$work/huge"
+if [ $(( $(date +%s) - start )) -le 5 ] && [ ! -e "$work/huge" ]; then ok "memory_refused_quickly"; else bad "memory_refused_quickly: took $(( $(date +%s) - start )) s or wrote $work/huge"; fi
+SURGE_MEMORY_LIMIT=1e5 expect memory_limit_env 2 'two_disks_2d.yaml:[0-9]+:[0-9]+: bodies: the run needs about [0-9.]+ MB of memory .* more than the 0.1 MB available' -- "$surge" check "$src/scenes/two_disks_2d.yaml"
 expect bad_option 2 '' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --threads 0
 expect no_subcommand 2 '' -- "$surge"
 expect run_small 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out" --set time.end=0.2 --threads 2 --progress plain

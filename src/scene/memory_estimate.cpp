@@ -1,0 +1,129 @@
+// Memory estimate of a run (memory_estimate.h).
+#include "scene/memory_estimate.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "core/particles.h"
+#include "grid/sparse_grid.h"
+#include "step/workspace.h"
+
+namespace surge {
+namespace {
+
+// Bytes of one element of a std::vector member type.
+template <typename V>
+constexpr double Elem() {
+  return double(sizeof(typename V::value_type));
+}
+
+// A number from the first line of a file, or -1.
+double ReadNumber(const char* path) {
+  std::ifstream in(path);
+  std::string word;
+  if (!(in >> word) || word == "max") return -1;
+  try {
+    return std::stod(word);
+  } catch (...) {
+    return -1;
+  }
+}
+
+}  // namespace
+
+double BytesPerParticle() {
+  using P = Particles;
+  // State: every Particles array.
+  double b = Elem<decltype(P::x)>() + Elem<decltype(P::v)>() + Elem<decltype(P::C)>() +
+             Elem<decltype(P::F)>() + Elem<decltype(P::stress)>() + Elem<decltype(P::strain)>() +
+             Elem<decltype(P::elastic_b)>() + Elem<decltype(P::history)>() +
+             Elem<decltype(P::mass)>() + Elem<decltype(P::volume0)>() +
+             Elem<decltype(P::ext_force)>() + Elem<decltype(P::material)>() +
+             Elem<decltype(P::body)>() + Elem<decltype(P::id)>();
+  // Workspace per-particle scratch.
+  using W = Workspace;
+  b += Elem<decltype(W::velocity_gradient)>() + Elem<decltype(W::x_new)>() +
+       Elem<decltype(W::exit_flag)>() + Elem<decltype(W::reorder)>();
+  // Grid binning.
+  using G = SparseGrid;
+  b += Elem<decltype(G::particle_block)>() + Elem<decltype(G::sorted)>() +
+       Elem<decltype(G::particle_block_coord)>();
+  // Results writer snapshot scratch (hdf5_writer.cpp): position, velocity (3), stress (6) and
+  // five scalars, float64.
+  b += (3 + 3 + 6 + 5) * sizeof(double);
+  return b;
+}
+
+double BytesPerBlock(int fields) {
+  using G = SparseGrid;
+  const double node = Elem<decltype(G::mass)>() + Elem<decltype(G::momentum)>() +
+                      Elem<decltype(G::force)>() + Elem<decltype(G::velocity)>() +
+                      Elem<decltype(G::velocity_new)>() + Elem<decltype(G::reaction)>();
+  const double field = Elem<decltype(G::field_mass)>() + Elem<decltype(G::field_momentum)>() +
+                       Elem<decltype(G::field_force)>() + Elem<decltype(G::field_mass_moment)>() +
+                       Elem<decltype(G::field_velocity)>() + Elem<decltype(G::field_velocity_new)>();
+  const double topology = Elem<decltype(G::block_origin)>() + Elem<decltype(G::neighbor)>() +
+                          Elem<decltype(G::wall_partials)>();
+  return kBlockNodes * (node + fields * field) + topology;
+}
+
+MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields) {
+  MemoryEstimate m;
+  m.particles = particles;
+  m.grid_blocks = grid_blocks;
+  m.particle_bytes = particles * BytesPerParticle();
+  m.grid_bytes = grid_blocks * BytesPerBlock(fields);
+  return m;
+}
+
+double BlocksCovering(const Vec3& lo, const Vec3& hi, Real dx, int dim) {
+  const double block = double(kBlockDim) * dx;  // [m]
+  double blocks = 1;
+  for (int a = 0; a < (dim == 2 ? 2 : 3); ++a) {
+    const double extent = std::max(0.0, double(hi[a] - lo[a]));
+    blocks *= std::ceil(extent / block) + 2;
+  }
+  return blocks;
+}
+
+double AvailableMemory() {
+  double available = std::numeric_limits<double>::infinity();
+  std::ifstream meminfo("/proc/meminfo");
+  for (std::string line; std::getline(meminfo, line);) {
+    if (line.rfind("MemAvailable:", 0) != 0) continue;
+    std::istringstream in(line.substr(13));
+    double kb = 0;
+    if (in >> kb) available = kb * 1024.0;
+  }
+  if (!std::isfinite(available)) {  // no /proc/meminfo: free physical pages
+    const long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && size > 0) available = double(pages) * double(size);
+  }
+  const double limit = ReadNumber("/sys/fs/cgroup/memory.max");
+  const double used = ReadNumber("/sys/fs/cgroup/memory.current");
+  if (limit > 0 && used >= 0) available = std::min(available, std::max(0.0, limit - used));
+  if (const char* budget = std::getenv("SURGE_MEMORY_LIMIT")) {
+    char* end = nullptr;
+    const double v = std::strtod(budget, &end);
+    if (end != budget && v > 0) available = std::min(available, v);
+  }
+  return available;
+}
+
+std::string FormatBytes(double bytes) {
+  char buf[48];
+  if (bytes >= 1e9)
+    std::snprintf(buf, sizeof buf, "%.3g GB", bytes / 1e9);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1e6);
+  return buf;
+}
+
+}  // namespace surge

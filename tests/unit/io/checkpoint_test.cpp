@@ -1,0 +1,365 @@
+// Checkpoints (io/checkpoint.h, issue 9): a State with every field set (NaN included) reads back
+// bit for bit; the file appears only whole (no .tmp left, rewrite replaces); foreign files are
+// refused naming the path; ListCheckpoints orders by step. ResultsWriter's reopening constructor
+// (a restart) cuts snapshots, energy, force and rigid series and their CSV files back to a
+// ResultPosition and continues the force summary. The scene keys output.checkpoint_every and
+// output.checkpoints_keep.
+#include "io/checkpoint.h"
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+
+#include "io/results_reader.h"
+#include "io/results_writer.h"
+#include "scene/scene.h"
+
+namespace surge {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CheckpointTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("surge_checkpoint_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+// Byte equality of two vectors (NaN == NaN when the bits agree).
+template <typename T>
+bool SameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+bool SameRigid(const std::vector<RigidBodyState>& a, const std::vector<RigidBodyState>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t k = 0; k < a.size(); ++k) {
+    if (a[k].position != b[k].position || a[k].rotation != b[k].rotation ||
+        a[k].velocity != b[k].velocity || a[k].angular_velocity != b[k].angular_velocity)
+      return false;
+  }
+  return true;
+}
+
+Checkpoint FullCheckpoint(size_t n) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1e3, 1e3);
+  const auto vec = [&] { return Vec3(u(rng), u(rng), u(rng)); };
+  const auto mat = [&] { return Mat3(Mat3::NullaryExpr([&](Eigen::Index, Eigen::Index) { return u(rng); })); };
+  Checkpoint c;
+  State& s = c.state;
+  s.time = 0.1 + 1e-17;
+  s.step = 1234567;
+  s.dt = 3.3e-5;
+  s.particles_removed = 42;
+  s.wall_work = -std::nextafter(1.5, 2.0);
+  Particles& P = s.particles;
+  P.Resize(n);
+  for (size_t p = 0; p < n; ++p) {
+    P.x[p] = vec();
+    P.v[p] = vec();
+    P.C[p] = mat();
+    P.F[p] = mat();
+    P.stress[p] = mat();
+    P.strain[p] = mat();
+    P.elastic_b[p] = mat();
+    for (Real& h : P.history[p]) h = u(rng);
+    P.mass[p] = u(rng);
+    P.volume0[p] = u(rng);
+    P.ext_force[p] = vec();
+    P.material[p] = int32_t(p % 3);
+    P.body[p] = int32_t(p % 2);
+    P.id[p] = int64_t(1e12) + int64_t(p);
+  }
+  if (n > 0) P.stress[0](1, 2) = std::numeric_limits<Real>::quiet_NaN();
+  s.groups = {{0, 0, n / 2}, {2, n / 2, n}};
+  s.rigid = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
+  c.bullet = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
+  c.next_output = 0.15;
+  c.next_checkpoint = 0.2;
+  c.result.snapshots = 4;
+  c.result.energy_rows = 1001;
+  c.result.force_rows = 1000;
+  c.result.rigid_rows = 999;
+  c.result.force_samples = 1000;
+  StructurePeak a;
+  a.peak_force = 12.5;
+  a.peak_time = 0.0625;
+  a.force_at_peak = vec();
+  a.impulse = vec();
+  a.peak_contact_area = 3;
+  a.peak_wetted_height = 0.75;
+  a.faces.resize(2);
+  a.faces[1].impulse = vec();
+  StructurePeak b;  // peak_time NaN: no sample yet
+  c.result.force_peaks = {a, b};
+  c.name = "dam";
+  c.scene_path = "scenes/dam.yaml";
+  c.scene_text = "name: dam  # 20° ✓\n";
+  c.resolved_yaml = "name: dam\n";
+  c.version = "0.1";
+  c.git_hash = "abc";
+  return c;
+}
+
+TEST_F(CheckpointTest, RoundTripIsBitwise) {
+  for (size_t n : {size_t(0), size_t(7), size_t(5000)}) {
+    const Checkpoint c = FullCheckpoint(n);
+    const std::string path = CheckpointPath(dir_.string(), "dam", c.state.step);
+    EXPECT_EQ(path, (dir_ / "checkpoints" / "dam_step_001234567.h5").string());
+    WriteCheckpoint(path, c);
+    const Checkpoint r = ReadCheckpoint(path);
+    const Particles &P = c.state.particles, &Q = r.state.particles;
+    EXPECT_TRUE(SameBytes(P.x, Q.x) && SameBytes(P.v, Q.v) && SameBytes(P.C, Q.C) &&
+                SameBytes(P.F, Q.F) && SameBytes(P.stress, Q.stress) &&
+                SameBytes(P.strain, Q.strain) && SameBytes(P.elastic_b, Q.elastic_b) &&
+                SameBytes(P.history, Q.history) && SameBytes(P.mass, Q.mass) &&
+                SameBytes(P.volume0, Q.volume0) && SameBytes(P.ext_force, Q.ext_force) &&
+                SameBytes(P.material, Q.material) && SameBytes(P.body, Q.body) &&
+                SameBytes(P.id, Q.id))
+        << "n = " << n;
+    EXPECT_EQ(r.state.time, c.state.time);
+    EXPECT_EQ(r.state.step, c.state.step);
+    EXPECT_EQ(r.state.dt, c.state.dt);
+    EXPECT_EQ(r.state.particles_removed, 42);
+    EXPECT_EQ(r.state.wall_work, c.state.wall_work);
+    ASSERT_EQ(r.state.groups.size(), 2u);
+    EXPECT_EQ(r.state.groups[1].material, 2);
+    EXPECT_EQ(r.state.groups[1].begin, n / 2);
+    EXPECT_EQ(r.state.groups[1].end, n);
+    EXPECT_TRUE(SameRigid(r.state.rigid, c.state.rigid));
+    EXPECT_TRUE(SameRigid(r.bullet, c.bullet));
+    EXPECT_EQ(r.next_output, 0.15);
+    EXPECT_EQ(r.next_checkpoint, 0.2);
+    EXPECT_EQ(r.result.snapshots, 4);
+    EXPECT_EQ(r.result.energy_rows, 1001);
+    EXPECT_EQ(r.result.force_rows, 1000);
+    EXPECT_EQ(r.result.rigid_rows, 999);
+    EXPECT_EQ(r.result.force_samples, 1000);
+    ASSERT_EQ(r.result.force_peaks.size(), 2u);
+    const StructurePeak& a = r.result.force_peaks[0];
+    EXPECT_EQ(a.peak_force, 12.5);
+    EXPECT_EQ(a.peak_time, 0.0625);
+    EXPECT_EQ(a.force_at_peak, c.result.force_peaks[0].force_at_peak);
+    EXPECT_EQ(a.impulse, c.result.force_peaks[0].impulse);
+    EXPECT_EQ(a.peak_contact_area, 3);
+    EXPECT_EQ(a.peak_wetted_height, 0.75);
+    ASSERT_EQ(a.faces.size(), 2u);
+    EXPECT_EQ(a.faces[1].impulse, c.result.force_peaks[0].faces[1].impulse);
+    EXPECT_TRUE(std::isnan(r.result.force_peaks[1].peak_time));
+    EXPECT_TRUE(r.result.force_peaks[1].faces.empty());
+    EXPECT_EQ(r.name, "dam");
+    EXPECT_EQ(r.scene_path, "scenes/dam.yaml");
+    EXPECT_EQ(r.scene_text, c.scene_text);
+    EXPECT_EQ(r.resolved_yaml, c.resolved_yaml);
+    EXPECT_EQ(r.scene_hash, SceneHash(c.scene_text));
+    EXPECT_EQ(r.resolved_hash, SceneHash(c.resolved_yaml));
+    EXPECT_EQ(r.version, "0.1");
+    EXPECT_EQ(r.git_hash, "abc");
+  }
+}
+
+TEST_F(CheckpointTest, WrittenWholeOrNotAtAll) {
+  Checkpoint c = FullCheckpoint(10);
+  const std::string path = CheckpointPath(dir_.string(), "dam", 5);
+  WriteCheckpoint(path, c);
+  c.state.time = 7;
+  WriteCheckpoint(path, c);  // replaces the file
+  EXPECT_EQ(ReadCheckpoint(path).state.time, 7);
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  // An unwritable folder: IoError naming the file, nothing under the final name.
+  const std::string blocked = (dir_ / "file" / "checkpoints" / "x_step_000000001.h5").string();
+  std::ofstream(dir_ / "file") << "a file, not a folder";
+  EXPECT_THROW(WriteCheckpoint(blocked, c), IoError);
+}
+
+TEST_F(CheckpointTest, ForeignFilesAreRefusedNamingThePath) {
+  const auto expect_error = [](const std::string& path, const std::string& fragment) {
+    try {
+      ReadCheckpoint(path);
+      ADD_FAILURE() << "no IoError for " << path;
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  expect_error((dir_ / "missing.h5").string(), "no such file");
+  std::ofstream(dir_ / "text.h5") << "not hdf5";
+  expect_error((dir_ / "text.h5").string(), "not an HDF5 file");
+  Model m;
+  m.name = "result";
+  m.dx = 0.5;
+  { ResultsWriter w(dir_.string(), "result", RunMetadata{}, m); }
+  expect_error((dir_ / "result.h5").string(), "not a Surge checkpoint");
+}
+
+TEST_F(CheckpointTest, ListedOldestFirst) {
+  const Checkpoint c = FullCheckpoint(1);
+  for (int64_t step : {1000, 20, 300}) WriteCheckpoint(CheckpointPath(dir_.string(), "dam", step), c);
+  WriteCheckpoint(CheckpointPath(dir_.string(), "dam_b", 1), c);  // another run's name
+  std::ofstream(dir_ / "checkpoints" / "dam_step_000000400.h5.tmp") << "partial";
+  const std::vector<std::string> list = ListCheckpoints(dir_.string(), "dam");
+  ASSERT_EQ(list.size(), 3u);
+  EXPECT_EQ(fs::path(list[0]).filename(), "dam_step_000000020.h5");
+  EXPECT_EQ(fs::path(list[2]).filename(), "dam_step_000001000.h5");
+  EXPECT_TRUE(ListCheckpoints((dir_ / "none").string(), "dam").empty());
+}
+
+size_t CsvLines(const std::string& path) {
+  std::ifstream in(path);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
+hsize_t Rows(hid_t f, const char* name) {
+  const hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+  const hid_t space = H5Dget_space(ds);
+  hsize_t dims[2] = {0, 0};
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  H5Sclose(space);
+  H5Dclose(ds);
+  return dims[0];
+}
+
+// Writes `rows` steps of forces and rigid rows, a snapshot every 10 steps.
+void WriteSteps(ResultsWriter& w, State& s, int from, int to) {
+  for (int k = from; k < to; ++k) {
+    s.time = 0.01 * (k + 1);
+    s.step = k + 1;
+    ContactReport r;
+    r.structures.resize(1);
+    r.structures[0].force = Vec3(k, -k, 0.5 * k);
+    r.structures[0].faces.resize(1);
+    r.structures[0].faces[0].force = Vec3(k, 0, 0);
+    w.AppendEnergy(EnergyRecord{s.time, s.step, 0.01, double(k), 0, 0, 0});
+    w.AppendForces(s.time, s.step, 0.01, r);
+    s.rigid[0].position.x() = 0.001 * k;
+    w.AppendRigid(s.time, s.step, s.rigid);
+    if ((k + 1) % 10 == 0) w.WriteSnapshot(s);
+  }
+}
+
+TEST_F(CheckpointTest, ResumedResultIsCutBackToTheCheckpoint) {
+  Model m;
+  m.name = "run";
+  m.dx = 0.5;
+  const std::vector<ForceChannel> channels = {{"wall", {"front"}}};
+  State s;
+  s.particles.Resize(3);
+  for (Mat3& F : s.particles.F) F = Mat3::Identity();
+  s.rigid.resize(1);
+  ResultPosition at;
+  {
+    ResultsWriter w(dir_.string(), "run", RunMetadata{}, m);
+    w.BeginForces(channels);
+    w.BeginRigid({"box"});
+    w.WriteSnapshot(s);
+    WriteSteps(w, s, 0, 25);
+    at = w.Flush();
+    WriteSteps(w, s, 25, 47);  // the part a restart redoes
+    w.WriteSnapshot(s);
+    w.Close(StageSeconds{}, 47, 1.0, "interrupted");
+  }
+  EXPECT_EQ(at.snapshots, 3);
+  EXPECT_EQ(at.energy_rows, 25);
+  EXPECT_EQ(at.force_rows, 25);
+  EXPECT_EQ(at.rigid_rows, 25);
+  EXPECT_EQ(at.force_samples, 25);
+  ASSERT_EQ(at.force_peaks.size(), 1u);
+  EXPECT_EQ(at.force_peaks[0].peak_time, 0.25);
+  {
+    ResultsWriter w(dir_.string(), "run", m, at);
+    w.BeginForces(channels);
+    w.BeginRigid({"box"});
+    EXPECT_EQ(w.snapshot_count(), 3);
+    EXPECT_EQ(w.force_summary().samples(), 25);
+    EXPECT_EQ(w.force_summary().structure(0).peak_time, 0.25);
+    EXPECT_EQ(CsvLines(w.forces_csv_path("wall")), 26u);  // header + 25 rows
+    EXPECT_EQ(CsvLines(w.rigid_csv_path("box")), 26u);
+    s.step = 25;
+    WriteSteps(w, s, 25, 30);
+    w.Close(StageSeconds{}, 30, 1.0, "completed");
+  }
+  const hid_t f = H5Fopen((dir_ / "run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  EXPECT_EQ(Rows(f, "/energy/time"), 30u);
+  EXPECT_EQ(Rows(f, "/forces/wall/force"), 30u);
+  EXPECT_EQ(Rows(f, "/forces/wall/faces/front/contact_nodes"), 30u);
+  EXPECT_EQ(Rows(f, "/rigid/box/position"), 30u);
+  EXPECT_GT(H5Lexists(f, "/snapshots/000003", H5P_DEFAULT), 0);  // written at step 30
+  EXPECT_EQ(H5Lexists(f, "/snapshots/000004", H5P_DEFAULT), 0);  // the old run's, removed
+  H5Fclose(f);
+  const StoredResult r = ReadResultForces((dir_ / "run.h5").string());
+  EXPECT_EQ(r.exit_status, "completed");
+  ASSERT_EQ(r.structures.size(), 1u);
+  EXPECT_EQ(r.structures[0].time.size(), 30u);
+  EXPECT_EQ(r.structures[0].force[29], Vec3(29, -29, 14.5));
+  EXPECT_EQ(CsvLines((dir_ / "forces_wall.csv").string()), 31u);
+  EXPECT_EQ(CsvLines((dir_ / "rigid_box.csv").string()), 31u);
+
+  // A position beyond what the result holds is refused.
+  ResultPosition beyond = at;
+  beyond.force_rows = 1000;
+  try {
+    ResultsWriter w(dir_.string(), "run", m, beyond);
+    w.BeginForces(channels);
+    ADD_FAILURE() << "no IoError for a result shorter than the checkpoint";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("fewer than the checkpoint's 1000"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ResultsWriter((dir_ / "elsewhere").string(), "run", m, at), IoError);
+  EXPECT_THROW(ResultsWriter(dir_.string(), "../run", RunMetadata{}, m), IoError);
+}
+
+TEST(CheckpointSceneKeysTest, DefaultsRangesAndResolvedScene) {
+  const std::string base =
+      "name: t\n"
+      "dimension: 2\n"
+      "time: {end: 1.0}\n"
+      "grid: {cell_size: 0.25}\n"
+      "domain: {min: [0, 0], max: [2, 2]}\n"
+      "materials:\n"
+      "  m: {model: linear_elastic, density: 1000, youngs_modulus: 1.0e6, poisson_ratio: 0.3}\n"
+      "bodies:\n"
+      "  - {name: b, material: m, region: {box: {min: [0, 0], max: [1, 1]}}}\n";
+  const LoadedScene plain = LoadSceneFromString(base, "t.yaml");
+  EXPECT_EQ(plain.model.output.checkpoint_every, 0);
+  EXPECT_EQ(plain.model.output.checkpoints_keep, 3);
+  EXPECT_EQ(plain.resolved_yaml.find("checkpoint"), std::string::npos)
+      << "defaults stay out of the resolved scene (sweep digests)";
+  const LoadedScene set =
+      LoadSceneFromString(base + "output: {checkpoint_every: 0.25, checkpoints_keep: 5}\n", "t.yaml");
+  EXPECT_EQ(set.model.output.checkpoint_every, 0.25);
+  EXPECT_EQ(set.model.output.checkpoints_keep, 5);
+  const LoadedScene again = LoadSceneFromString(set.resolved_yaml, "resolved.yaml");
+  EXPECT_EQ(again.model.output.checkpoint_every, 0.25);
+  EXPECT_EQ(again.model.output.checkpoints_keep, 5);
+  for (const char* bad : {"output: {checkpoint_every: -1}\n", "output: {checkpoints_keep: 0}\n",
+                          "output: {checkpoints_keep: 2.5}\n"}) {
+    try {
+      LoadSceneFromString(base + bad, "t.yaml");
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("t.yaml:10:"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("output.checkpoint"), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace surge
