@@ -76,6 +76,10 @@ struct OutputPlan {
   Real every = 0;          // particle snapshot interval [s]; 0 = first and last only
   bool vdb = false;        // also write grid fields (mass, velocity) as .vdb per snapshot
   bool energy = true;      // energy series every step
+  // Checkpoints (<out>/checkpoints/<name>_step_<step>.h5, docs/results-format.md): written every
+  // checkpoint_every [s] of simulated time (0 = only on Ctrl-C); the newest checkpoints_keep kept.
+  Real checkpoint_every = 0;
+  int checkpoints_keep = 3;
 };
 
 struct Model {
@@ -97,10 +101,6 @@ struct Model {
   std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none
   std::vector<BodyInfo> bodies;
   std::vector<Obstacle> obstacles;       // rigid structures (src/contact), in scene order
-  // Checkpoints (<out>/checkpoints/<name>_step_<step>.h5, docs/results-format.md): written every
-  // checkpoint_every [s] of simulated time (0 = only on Ctrl-C); the newest checkpoints_keep kept.
-  Real checkpoint_every = 0;
-  int checkpoints_keep = 3;
   std::vector<Sensor> sensors;           // force sensors (src/contact), in scene order
   std::vector<BodyContact> body_contacts;  // MPM-MPM contact pairs; empty = one velocity field
   // Velocity field of each body (index as bodies) when body_contacts is not empty: the bodies

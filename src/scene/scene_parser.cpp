@@ -1296,6 +1296,12 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
     if (o["every"]) spec.output.every = NonNegative(o["every"], "output.every", "s");
     if (o["vdb"]) spec.output.vdb = Bool(o["vdb"], "output.vdb");
     if (o["energy"]) spec.output.energy = Bool(o["energy"], "output.energy");
+    if (o["checkpoint_every"])
+      spec.output.checkpoint_every = NonNegative(o["checkpoint_every"], "output.checkpoint_every", "s");
+    if (o["checkpoints_keep"]) {
+      spec.output.checkpoints_keep =
+          static_cast<int>(Integer(o["checkpoints_keep"], "output.checkpoints_keep", 1, 1000));
+    }
   }
   if (root["analysis"]) spec.analysis = ParseAnalysis(root["analysis"], spec);
   return spec;
@@ -1331,12 +1337,6 @@ void EmitRegion(YAML::Emitter& e, const RegionShape& region, int dim) {
     EmitVector(e, box->max, dim);
   } else if (const auto* sphere = std::get_if<SphereRegion>(&region)) {
     e << YAML::Key << "sphere" << YAML::Value << YAML::BeginMap;
-    if (o["checkpoint_every"])
-      spec.output.checkpoint_every = NonNegative(o["checkpoint_every"], "output.checkpoint_every", "s");
-    if (o["checkpoints_keep"]) {
-      spec.output.checkpoints_keep =
-          static_cast<int>(Integer(o["checkpoints_keep"], "output.checkpoints_keep", 1, 1000));
-    }
     e << YAML::Key << "center" << YAML::Value;
     EmitVector(e, sphere->center, dim);
     e << YAML::Key << "radius" << YAML::Value << Num(sphere->radius);
@@ -1634,6 +1634,12 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   e << YAML::Key << "every" << YAML::Value << Num(spec.output.every);
   e << YAML::Key << "vdb" << YAML::Value << spec.output.vdb;
   e << YAML::Key << "energy" << YAML::Value << spec.output.energy;
+  // Only when set: they do not change the results, and older resolved scenes (sweep digests,
+  // docs/sweeps.md) stay the same.
+  if (spec.output.checkpoint_every > 0)
+    e << YAML::Key << "checkpoint_every" << YAML::Value << Num(spec.output.checkpoint_every);
+  if (spec.output.checkpoints_keep != OutputSpec{}.checkpoints_keep)
+    e << YAML::Key << "checkpoints_keep" << YAML::Value << spec.output.checkpoints_keep;
   e << YAML::EndMap;
   if (spec.analysis.present) {  // as written; smoothing and steady state with their defaults
     const AnalysisSettings& a = spec.analysis.settings;
@@ -1680,12 +1686,6 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
         << Num((*ss.window)[0]) << Num((*ss.window)[1]) << YAML::EndSeq;
     }
     e << YAML::EndMap;
-  // Only when set: they do not change the results, and older resolved scenes (sweep digests,
-  // docs/sweeps.md) stay the same.
-  if (spec.output.checkpoint_every > 0)
-    e << YAML::Key << "checkpoint_every" << YAML::Value << Num(spec.output.checkpoint_every);
-  if (spec.output.checkpoints_keep != OutputSpec{}.checkpoints_keep)
-    e << YAML::Key << "checkpoints_keep" << YAML::Value << spec.output.checkpoints_keep;
     e << YAML::EndMap;
   }
   if (!spec.parameters.empty()) {  // values already substituted; kept for the record

@@ -230,10 +230,10 @@ struct OutputSpec {
   Real every = 0;  // [s]; 0 = first and last only
   bool vdb = false;
   bool energy = true;
-};
-
   Real checkpoint_every = 0;  // [s] of simulated time; 0 = no periodic checkpoints
   int checkpoints_keep = 3;   // newest periodic checkpoints kept
+};
+
 // `analysis:` (docs/scene-reference.md): what `surge forces` and the end of `surge run` analyse.
 // `settings` holds the values as written (unset reference values stay unset); ResolveAnalysis
 // fills the defaults.

@@ -26,10 +26,10 @@ struct Workspace {
   std::vector<Mat3> rigid_frame0;    // R_bullet(0) by ObstacleMotion::body
   std::vector<Vec3> rigid_offset;    // reference point in Bullet's body frame, by body
   std::vector<Real> rigid_mass;      // [kg], by body
-};
-
-}  // namespace surge
   // Restart only (io/checkpoint.h): Bullet's own state of each dynamic body as the checkpoint
   // saved it, by body; used once, when the Bullet world is built, instead of re-deriving it from
   // State::rigid (which would round the centre of mass differently in the last bit).
   std::vector<RigidWorld::BodyState> rigid_restart;
+};
+
+}  // namespace surge
