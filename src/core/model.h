@@ -46,6 +46,27 @@ struct AntiLocking {
   AntiLockingStrain strain = AntiLockingStrain::kTotal;
 };
 
+// Cundall's local non-viscous damping of the grid momentum balance (Anura3D manual §6.3.1, eqs.
+// (6.22)-(6.23); docs/antilocking.md "Local damping"): f_damp = -alpha |f| sign(v) per component of
+// every node, f = f_ext - f_int the unbalanced force. One alpha for the whole grid, as the manual
+// gives one per degree of freedom; active for t < until (quasi-static initialisation, §6.4).
+struct LocalDamping {
+  Real alpha = 0;        // local damping factor [-], 0 <= alpha < 1; 0 = off
+  Real until = 1e300;    // damping acts while t_n < until [s]; default: the whole run
+  // The factor at time t: alpha before `until`, 0 after.
+  Real At(Real t) const { return t < until ? alpha : 0; }
+};
+
+// Artificial bulk viscosity of a material for shocks (von Neumann & Richtmyer 1950, J. Appl.
+// Phys. 21:232; Wilkins 1980, J. Comput. Phys. 36:281; LS-DYNA Theory Manual, "Bulk viscosity"):
+// q = rho l (c0 l (tr d)^2 - c1 c tr d) when tr d < 0, else 0, with l = dx and c the elastic wave
+// speed; added to the pressure of the internal force only (src/stabilize/bulk_viscosity.cpp).
+struct BulkViscosity {
+  bool enabled = false;
+  Real quadratic = 1.5;  // c0 [-] (LS-DYNA default Q1 = 1.5)
+  Real linear = 0.06;    // c1 [-] (LS-DYNA default Q2 = 0.06)
+};
+
 struct TimeControl {
   Real end = 0;        // simulated end time [s]
   Real cfl = 0.4;      // Courant number C in dt = C dx / max(c + |v|) (spec §1.7)
@@ -99,6 +120,8 @@ struct Model {
   ExitPolicy exit_policy = ExitPolicy::kRemove;
   std::vector<Material> materials;
   std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none
+  std::vector<BulkViscosity> bulk_viscosity;  // per material (index as materials); empty = none
+  LocalDamping damping;                  // scene key `damping` (off by default)
   std::vector<BodyInfo> bodies;
   std::vector<Obstacle> obstacles;       // rigid structures (src/contact), in scene order
   std::vector<Sensor> sensors;           // force sensors (src/contact), in scene order

@@ -20,6 +20,7 @@ enum class Stage : int {
   kSensors,            // only with force sensors (src/contact)
   kAntiLocking,        // only when a material is anti-locked (src/stabilize)
   kUpdateStress,
+  kBulkViscosity,      // only when a material has a bulk viscosity (src/stabilize): q around P2G
   kDomainExit,
   kCheckState,
   kEnergy,

@@ -11,6 +11,7 @@ struct StepContext {
   Real inv_dx = 0;            // 1/dx [1/m]
   Real ramp = 1;              // external load factor min(t/t_c, 1) (seed App. B.2.3)
   Vec3 gravity = Vec3::Zero();  // ramped gravity [m/s^2]
+  Real damping = 0;           // local damping factor alpha of this step (Model::damping) [-]
 };
 
 }  // namespace surge

@@ -333,7 +333,10 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
     model.materials.push_back(
         Material{m.name, m.density, FindMaterialKind(m.model).make_params(m)});
     model.antilocking.push_back(ResolvedAntiLocking(m));
+    model.bulk_viscosity.push_back(m.bulk_viscosity);
   }
+  model.damping.alpha = spec.damping.local;
+  if (spec.damping.until) model.damping.until = *spec.damping.until;
   for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
   for (size_t o = 0; o < spec.obstacles.size(); ++o) model.obstacles.push_back(BuildObstacle(spec, o));
   for (const SensorSpec& s : spec.sensors) model.sensors.push_back(Sensor{s.name, s.min, s.max});

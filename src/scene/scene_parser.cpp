@@ -492,6 +492,7 @@ std::vector<std::string> MaterialKeys(const MaterialKind& kind) {
   }
   for (const ParamDesc& d : kind.params) keys.push_back(d.key);
   keys.push_back("antilocking");
+  keys.push_back("bulk_viscosity");
   return keys;
 }
 
@@ -550,6 +551,26 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
              "expected volumetric, got " + Describe(a) +
                  " (the volumetric-deviatoric approach is not implemented yet, issue #4)");
       }
+    }
+  }
+  if (const YAML::Node bv = n["bulk_viscosity"]) {
+    // bulk_viscosity: {quadratic: c0, linear: c1} (docs/antilocking.md, "Artificial bulk
+    // viscosity"); an empty map takes the LS-DYNA defaults 1.5 and 0.06.
+    const std::string bp = Child(path, "bulk_viscosity");
+    if (!bv.IsMap() && !(bv.IsNull())) {
+      Fail(bv, bp, "expected a map {quadratic: c0, linear: c1}, got " + Describe(bv));
+    }
+    if (bv.IsMap()) ExpectMap(bv, bp, {"quadratic", "linear"});
+    m.bulk_viscosity.enabled = true;
+    if (bv.IsMap() && bv["quadratic"]) {
+      m.bulk_viscosity.quadratic =
+          Ranged(bv["quadratic"], Child(bp, "quadratic"), "-", 0, true, 10, true);
+    }
+    if (bv.IsMap() && bv["linear"]) {
+      m.bulk_viscosity.linear = Ranged(bv["linear"], Child(bp, "linear"), "-", 0, true, 1, true);
+    }
+    if (m.bulk_viscosity.quadratic == 0 && m.bulk_viscosity.linear == 0) {
+      Fail(bv, bp, "quadratic and linear are both 0: leave bulk_viscosity out to switch it off");
     }
   }
   if (kind.check) {
@@ -1093,8 +1114,9 @@ AnalysisSpec Parser::ParseAnalysis(const YAML::Node& n, const SceneSpec& spec) c
 SceneSpec Parser::Parse(const YAML::Node& root) {
   SceneSpec spec;
   const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
-                                        "grid",   "domain",    "materials", "bodies",  "obstacles",
-                                        "sensors", "body_contact", "output", "analysis", "parameters"};
+                                        "damping", "grid",     "domain",    "materials", "bodies",
+                                        "obstacles", "sensors", "body_contact", "output", "analysis",
+                                        "parameters"};
   if (!root.IsDefined() || root.IsNull()) {
     throw SceneError(source_, 0, 0, "", "the scene is empty (expected a map with keys " + Join(top) + ")");
   }
@@ -1117,6 +1139,13 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
   }
   if (root["gravity"]) spec.gravity = Vector(root["gravity"], "gravity", "m/s^2");
   if (root["gravity_ramp"]) spec.gravity_ramp = NonNegative(root["gravity_ramp"], "gravity_ramp", "s");
+  if (const YAML::Node d = root["damping"]) {
+    // damping: {local: alpha, until: t} (Anura3D manual §6.3.1; docs/scene-reference.md).
+    ExpectMap(d, "damping", {"local", "until"});
+    spec.damping.loc = Loc(d, "damping");
+    spec.damping.local = Ranged(Need(d, "damping", "local"), "damping.local", "-", 0, true, 1, false);
+    if (d["until"]) spec.damping.until = Positive(d["until"], "damping.until", "s");
+  }
 
   {
     const YAML::Node g = Need(root, "", "grid");
@@ -1287,6 +1316,12 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
         Fail(cs[i], cp, "body contact needs grid.update: usl (the MUSL re-map of per-body fields is not implemented)");
       }
       spec.body_contacts.push_back(std::move(c));
+    }
+    if (spec.damping.local > 0) {
+      // The per-body fields of body_contact.cpp predict their own velocities; damping them
+      // consistently with the common field is not implemented.
+      Fail(root["damping"]["local"], "damping.local",
+           "local damping does not work with body_contact yet (per-body velocity fields)");
     }
   }
 
@@ -1510,6 +1545,12 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   e << YAML::Key << "gravity" << YAML::Value;
   EmitVector(e, spec.gravity, dim);
   e << YAML::Key << "gravity_ramp" << YAML::Value << Num(spec.gravity_ramp);
+  if (spec.damping.local > 0) {  // only when on: resolved scenes without it stay the same
+    e << YAML::Key << "damping" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    e << YAML::Key << "local" << YAML::Value << Num(spec.damping.local);
+    if (spec.damping.until) e << YAML::Key << "until" << YAML::Value << Num(*spec.damping.until);
+    e << YAML::EndMap;
+  }
 
   e << YAML::Key << "grid" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "cell_size" << YAML::Value << Num(spec.grid.cell_size);
@@ -1564,6 +1605,11 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
       << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
       << "approach" << YAML::Value << "volumetric" << YAML::Key << "strain" << YAML::Value
       << NameOf(kAntiLockingStrainNames, al.strain) << YAML::EndMap;
+    if (m.bulk_viscosity.enabled) {  // only when on (resolved scenes without it stay the same)
+      e << YAML::Key << "bulk_viscosity" << YAML::Value << YAML::Flow << YAML::BeginMap
+        << YAML::Key << "quadratic" << YAML::Value << Num(m.bulk_viscosity.quadratic)
+        << YAML::Key << "linear" << YAML::Value << Num(m.bulk_viscosity.linear) << YAML::EndMap;
+    }
     e << YAML::EndMap;
   }
   e << YAML::EndMap;

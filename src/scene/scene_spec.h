@@ -89,6 +89,8 @@ struct MaterialSpec {
   // of the material's class, ResolvedAntiLocking().
   std::optional<AntiLockingMethod> antilocking;
   AntiLockingStrain antilocking_strain = AntiLockingStrain::kTotal;
+  // `bulk_viscosity: {quadratic, linear}` (docs/antilocking.md); disabled when not written.
+  BulkViscosity bulk_viscosity;
   SourceLoc loc;
 
   // Value of a model key: as written, else the kind's default. Pre: `key` is one of the kind's.
@@ -243,12 +245,20 @@ struct AnalysisSpec {
   SourceLoc loc, structure_loc, face_loc;
 };
 
+// `damping:` (docs/scene-reference.md): Cundall local damping (core/model.h LocalDamping).
+struct DampingSpec {
+  Real local = 0;              // alpha [-], [0, 1); 0 = off
+  std::optional<Real> until;   // [s]; unset = the whole run
+  SourceLoc loc;
+};
+
 struct SceneSpec {
   std::string name;
   int dimension = 3;
   TimeSpec time;
   Vec3 gravity = Vec3::Zero();  // [m/s^2]
   Real gravity_ramp = 0;        // [s]
+  DampingSpec damping;
   GridSpec grid;
   DomainSpec domain;
   std::vector<MaterialSpec> materials;  // in file order; Model::materials has the same order

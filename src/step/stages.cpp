@@ -87,6 +87,21 @@ void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace
   UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles);
 }
 
+void BulkViscosityRateStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                            StepReport&) {
+  ComputeBulkViscosity(m, c, s.groups, s.particles, w.velocity_gradient, w.bulk_viscosity);
+}
+
+void BulkViscosityApplyStage(const Model&, const StepContext&, State& s, Workspace& w,
+                             StepReport&) {
+  ApplyBulkViscosity(s.particles, w.bulk_viscosity);
+}
+
+void BulkViscosityRestoreStage(const Model&, const StepContext&, State& s, Workspace& w,
+                               StepReport&) {
+  RestoreStress(s.particles, w.bulk_viscosity);
+}
+
 namespace {
 // Walled faces of the domain, in face order.
 std::vector<int> WalledFaces(const Model& m) {

@@ -6,6 +6,7 @@
 //         -> VelocityGradient -> UpdateStress
 //   then: DomainExit -> CheckState -> Energy
 //   AntiLocking (Mast 2013 Table 4.1) runs just before UpdateStress when a material asks for it.
+//   BulkViscosity (when a material has one): q_p after UpdateStress, sigma - q 1 around P2G.
 //   With obstacles: ObstacleContact after GridUpdate (node contact, reactions) and
 //   ObstacleProjection after the positions are committed (particles back onto the surface).
 //   With body contacts: BodyContact after the grid update and obstacles (per-body velocity
@@ -20,6 +21,7 @@
 
 #include "core/parallel.h"
 #include "materials/update_stress.h"
+#include "stabilize/bulk_viscosity.h"
 #include "step/stages.h"
 
 namespace surge {
@@ -28,7 +30,10 @@ Pipeline MakePipeline(const Model& model) {
   Pipeline p;
   p.push_back({Stage::kRebuildGrid, RebuildGridStage});
   p.push_back({Stage::kReorderParticles, ReorderParticlesStage});
+  const bool bulk_viscosity = AnyBulkViscosity(model);
+  if (bulk_viscosity) p.push_back({Stage::kBulkViscosity, BulkViscosityApplyStage});  // sigma - q 1
   p.push_back({Stage::kParticleToGrid, ParticleToGridStage});                  // (2.12)
+  if (bulk_viscosity) p.push_back({Stage::kBulkViscosity, BulkViscosityRestoreStage});
   p.push_back({Stage::kGridUpdate, GridUpdateStage});                          // (2.13)-(2.14)
   const bool obstacles = !model.obstacles.empty();
   if (obstacles) p.push_back({Stage::kObstacleContact, ObstacleContactStage});  // spec §5.3
@@ -50,6 +55,7 @@ Pipeline MakePipeline(const Model& model) {
   if (!model.sensors.empty()) p.push_back({Stage::kSensors, SensorsStage});  // all reactions in
   if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
   p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)
+  if (bulk_viscosity) p.push_back({Stage::kBulkViscosity, BulkViscosityRateStage});  // q_p
   p.push_back({Stage::kDomainExit, DomainExitStage});
   p.push_back({Stage::kCheckState, CheckStateStage});
   if (model.output.energy) p.push_back({Stage::kEnergy, EnergyStage});
@@ -61,10 +67,16 @@ void Step(const Model& model, const Pipeline& pipeline, State& state, Workspace&
   StepContext ctx;
   ctx.time = state.time;
   ctx.dt = NextTimeStep(model, state);
+  if (model.time.fixed_dt <= 0 && !model.bulk_viscosity.empty() && AnyBulkViscosity(model)) {
+    // Bulk viscosity stiffens the compression: the LS-DYNA bound l / (Q + sqrt(Q^2 + c^2) + |v|)
+    // from the last step (bulk_viscosity.h), times the Courant number.
+    ctx.dt = std::min(ctx.dt, model.time.cfl * work.bulk_viscosity.dt_bound);
+  }
   ctx.dx = model.dx;
   ctx.inv_dx = 1.0 / model.dx;
   ctx.ramp = RampFactor(model, state.time);
   ctx.gravity = ctx.ramp * model.gravity;
+  ctx.damping = model.damping.At(state.time);  // Anura3D §6.3: alpha, 0 after damping.until
   if (!(ctx.dt >= model.time.min_dt) || !std::isfinite(ctx.dt)) {
     report.health = Health{HealthStatus::kTimeStepTooSmall, -1,
                            "time step " + std::to_string(ctx.dt) + " s is below time.min_dt"};

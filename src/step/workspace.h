@@ -7,6 +7,7 @@
 #include "grid/sparse_grid.h"
 #include "rigid/rigid_world.h"
 #include "stabilize/antilocking.h"
+#include "stabilize/bulk_viscosity.h"
 #include "transfer/transfer.h"
 
 namespace surge {
@@ -18,6 +19,8 @@ struct Workspace {
   std::vector<uint8_t> exit_flag;       // scratch of DomainExit and ReorderParticles
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
   AntiLockingScratch antilocking;       // node sums of AntiLocking
+  BulkViscosityScratch bulk_viscosity;  // q_p between steps (not in checkpoints: a restart
+                                        // starts with q = 0)
   ContactScratch contact;               // broad phase and partial sums of the obstacle contact
   // Bullet world of the dynamic obstacles (built from Model + State on first use; the rigid
   // state of record is State::rigid), each dynamic body's handle and its Bullet frame at t = 0.

@@ -222,7 +222,7 @@ TEST(SceneParserTest, FluidKeys) {
   ExpectError(WithMaterial(water + "viscosity: 0.001, shear_modulus: 1e6}"), 7,
               "materials.steel.shear_modulus",
               "unknown key 'shear_modulus' (expected one of: model, density, bulk_modulus, "
-              "viscosity, equation_of_state, tait_gamma, antilocking)");
+              "viscosity, equation_of_state, tait_gamma, antilocking, bulk_viscosity)");
   ExpectError(WithMaterial(water + "viscosity: -0.001}"), 7, "materials.steel.viscosity",
               "must be >= 0 [Pa s], got -0.001");
   ExpectError(WithMaterial(water + "equation_of_state: tait}"), 7, "materials.steel.viscosity",
@@ -790,6 +790,55 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   const LoadedScene again = LoadSceneFromString(cell.resolved_yaml, "again.yaml");
   EXPECT_EQ(again.model.antilocking[0].method, AntiLockingMethod::kCell);
   EXPECT_EQ(again.model.antilocking[0].strain, AntiLockingStrain::kIncrement);
+}
+
+TEST(SceneParserTest, DampingKeys) {
+  // damping: {local, until} at the top level (line 12, appended).
+  ExpectError(kBase3 + "damping: {local: 1.0}\n", 12, "damping.local", "must be in [0, 1) [-]");
+  ExpectError(kBase3 + "damping: {until: 2}\n", 12, "damping.local", "missing required key 'local'");
+  ExpectError(kBase3 + "damping: {local: 0.7, until: 0}\n", 12, "damping.until", "must be > 0 [s]");
+  ExpectError(kBase3 + "damping: {local: 0.7, alpha: 0.7}\n", 12, "damping.alpha",
+              "unknown key 'alpha'");
+  const LoadedScene off = LoadSceneFromString(kBase3, "ok.yaml");
+  EXPECT_EQ(off.model.damping.alpha, 0);
+  EXPECT_EQ(off.resolved_yaml.find("damping"), std::string::npos) << off.resolved_yaml;
+  const LoadedScene on = LoadSceneFromString(kBase3 + "damping: {local: 0.7, until: 0.5}\n", "ok.yaml");
+  EXPECT_EQ(on.model.damping.alpha, 0.7);
+  EXPECT_EQ(on.model.damping.At(0.49), 0.7);
+  EXPECT_EQ(on.model.damping.At(0.5), 0);
+  const LoadedScene again = LoadSceneFromString(on.resolved_yaml, "again.yaml");
+  EXPECT_EQ(again.model.damping.alpha, 0.7);
+  EXPECT_EQ(again.model.damping.until, 0.5);
+  const LoadedScene always = LoadSceneFromString(kBase3 + "damping: {local: 0.1}\n", "ok.yaml");
+  EXPECT_EQ(always.model.damping.At(1e9), 0.1);
+}
+
+TEST(SceneParserTest, BulkViscosityKeys) {
+  const std::string steel =
+      "{model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3, ";
+  ExpectError(WithMaterial(steel + "bulk_viscosity: {quadratic: -1}}"), 7,
+              "materials.steel.bulk_viscosity.quadratic", "must be in [0, 10] [-]");
+  ExpectError(WithMaterial(steel + "bulk_viscosity: {linear: 2}}"), 7,
+              "materials.steel.bulk_viscosity.linear", "must be in [0, 1] [-]");
+  ExpectError(WithMaterial(steel + "bulk_viscosity: {q1: 1}}"), 7,
+              "materials.steel.bulk_viscosity.q1", "unknown key 'q1'");
+  ExpectError(WithMaterial(steel + "bulk_viscosity: {quadratic: 0, linear: 0}}"), 7,
+              "materials.steel.bulk_viscosity", "both 0");
+  ExpectError(WithMaterial(steel + "bulk_viscosity: 1.5}"), 7, "materials.steel.bulk_viscosity",
+              "expected a map");
+  const LoadedScene off = LoadSceneFromString(kBase3, "ok.yaml");
+  EXPECT_FALSE(off.model.bulk_viscosity[0].enabled);
+  EXPECT_EQ(off.resolved_yaml.find("bulk_viscosity"), std::string::npos);
+  const LoadedScene defaults = LoadSceneFromString(WithMaterial(steel + "bulk_viscosity: {}}"), "ok.yaml");
+  EXPECT_TRUE(defaults.model.bulk_viscosity[0].enabled);
+  EXPECT_EQ(defaults.model.bulk_viscosity[0].quadratic, 1.5);
+  EXPECT_EQ(defaults.model.bulk_viscosity[0].linear, 0.06);
+  const LoadedScene set =
+      LoadSceneFromString(WithMaterial(steel + "bulk_viscosity: {quadratic: 1.2, linear: 0.1}}"), "ok.yaml");
+  const LoadedScene again = LoadSceneFromString(set.resolved_yaml, "again.yaml");
+  EXPECT_TRUE(again.model.bulk_viscosity[0].enabled);
+  EXPECT_EQ(again.model.bulk_viscosity[0].quadratic, 1.2);
+  EXPECT_EQ(again.model.bulk_viscosity[0].linear, 0.1);
 }
 
 }  // namespace
