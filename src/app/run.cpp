@@ -195,6 +195,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   const bool restart = !options.restart.empty();
   Checkpoint resume;
   if (restart) {
+    state = State{};  // the seeded particles go before the checkpoint's arrive (peak memory)
     resume = ReadMatchingCheckpoint(scene, options);
     state = std::move(resume.state);
     resume.state = State{};
