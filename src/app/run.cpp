@@ -223,6 +223,11 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   Workspace work;
   for (const RigidBodyState& b : resume.bullet)
     work.rigid_restart.push_back({b.position, b.rotation, b.velocity, b.angular_velocity});
+  if (restart) {  // what the last step handed to the next one (io/checkpoint.h)
+    work.bulk_viscosity.q = std::move(resume.bulk_viscosity_q);
+    work.bulk_viscosity.id = std::move(resume.bulk_viscosity_id);
+    work.bulk_viscosity.dt_bound = resume.bulk_viscosity_dt_bound;
+  }
   StepReport report;
   Progress progress(options.progress, model.time.end);
 
@@ -285,6 +290,9 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
         c.bullet.push_back({b.position, b.rotation, b.velocity, b.angular_velocity});
       }
     }
+    c.bulk_viscosity_q = work.bulk_viscosity.q;
+    c.bulk_viscosity_id = work.bulk_viscosity.id;
+    c.bulk_viscosity_dt_bound = work.bulk_viscosity.dt_bound;
     c.state = std::move(state);  // written in place: no copy of the particles
     try {
       WriteCheckpoint(path, c);

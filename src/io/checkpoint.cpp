@@ -319,6 +319,17 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
       WriteDoubles(f, "bullet", FlattenRigid(c.bullet).data(), c.bullet.size(), kRigidColumns, tmp);
     }
     {
+      Handle g(H5Gcreate2(f, "workspace", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      Require(g.ok(), "create /workspace", tmp);
+      Require(c.bulk_viscosity_q.size() == c.bulk_viscosity_id.size(),
+              "write /workspace (bulk viscosity q and id differ in length)", tmp);
+      WriteDoubles(g.get(), "bulk_viscosity_q", c.bulk_viscosity_q.data(), c.bulk_viscosity_q.size(),
+                   0, tmp);
+      WriteArray(g.get(), "bulk_viscosity_id", H5T_STD_I64LE, H5T_NATIVE_INT64,
+                 c.bulk_viscosity_id.data(), c.bulk_viscosity_id.size(), 0, tmp);
+      WriteReal(g.get(), "bulk_viscosity_dt_bound", c.bulk_viscosity_dt_bound, tmp);
+    }
+    {
       const ResultPosition& r = c.result;
       Handle g(H5Gcreate2(f, "result", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
       Require(g.ok(), "create /result", tmp);
@@ -417,6 +428,14 @@ Checkpoint ReadCheckpoint(const std::string& path) {
     };
     s.rigid = read_rigid("rigid");
     c.bullet = read_rigid("bullet");
+  }
+  if (H5Lexists(f, "workspace", H5P_DEFAULT) > 0) {
+    Handle g(H5Gopen2(f, "workspace", H5P_DEFAULT), H5Gclose);
+    Require(g.ok(), "open /workspace", path);
+    const size_t n = Rows(g.get(), "bulk_viscosity_q", path);
+    ReadArray(g.get(), "bulk_viscosity_q", H5T_NATIVE_DOUBLE, n, 0, c.bulk_viscosity_q, path);
+    ReadArray(g.get(), "bulk_viscosity_id", H5T_NATIVE_INT64, n, 0, c.bulk_viscosity_id, path);
+    c.bulk_viscosity_dt_bound = ReadReal(g.get(), "bulk_viscosity_dt_bound", path);
   }
   {
     Handle g(H5Gopen2(f, "result", H5P_DEFAULT), H5Gclose);

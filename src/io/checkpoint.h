@@ -21,6 +21,12 @@ struct Checkpoint {
   // continued Bullet world starts bitwise where the interrupted one stood. Empty when the run
   // had no Bullet world yet.
   std::vector<RigidBodyState> bullet;
+  // Workspace values a step hands to the next (everything else in Workspace is rebuilt each
+  // step): the artificial bulk viscosity q_p of the last step with the particle ids it belongs to,
+  // and its time-step bound (stabilize/bulk_viscosity.h). Empty / 1e300 without bulk viscosity.
+  std::vector<Real> bulk_viscosity_q;          // [Pa]
+  std::vector<int64_t> bulk_viscosity_id;
+  Real bulk_viscosity_dt_bound = 1e300;        // [s]
   Real next_output = 0;      // time of the next periodic snapshot [s]
   Real next_checkpoint = 0;  // time of the next periodic checkpoint [s] (0: none)
   ResultPosition result;     // the result's series as they stood (ResultsWriter::Flush)

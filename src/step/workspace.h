@@ -1,4 +1,5 @@
-// Workspace: grid and per-particle scratch, rebuilt every step and never saved (STYLE H.4).
+// Workspace: grid and per-particle scratch, rebuilt every step and never saved (STYLE H.4), except
+// what a step hands to the next (bulk viscosity q_p), which checkpoints carry (io/checkpoint.h).
 #pragma once
 #include <memory>
 #include <vector>
@@ -19,8 +20,8 @@ struct Workspace {
   std::vector<uint8_t> exit_flag;       // scratch of DomainExit and ReorderParticles
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
   AntiLockingScratch antilocking;       // node sums of AntiLocking
-  BulkViscosityScratch bulk_viscosity;  // q_p between steps (not in checkpoints: a restart
-                                        // starts with q = 0)
+  BulkViscosityScratch bulk_viscosity;  // q_p between steps: its q, id and dt_bound are saved
+                                        // in checkpoints (io/checkpoint.h)
   ContactScratch contact;               // broad phase and partial sums of the obstacle contact
   // Bullet world of the dynamic obstacles (built from Model + State on first use; the rigid
   // state of record is State::rigid), each dynamic body's handle and its Bullet frame at t = 0.

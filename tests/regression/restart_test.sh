@@ -9,6 +9,8 @@
 #      result must equal the uninterrupted one bit for bit: every numeric dataset of the .h5
 #      (snapshots, energy, forces), the force summary attributes, the CSVs, the .xmf and
 #      summary.json (compare_results.py).
+#      The same scene with artificial bulk viscosity (q_p carried between steps), restarted on
+#      one thread: bit for bit too.
 #   2. A dynamic Bullet box falling through the air (3-D, 1600 particles) restarted from a
 #      checkpoint before it lands: bit for bit as well (Bullet's own body state is in the
 #      checkpoint). The same box resting on the floor (a Bullet contact with the floor slab)
@@ -58,6 +60,16 @@ expect dam_bitwise 0 'numeric datasets' -- $compare "$work/full" "$work/part" da
 # The restarted run wrote its own checkpoints again; the newest is the full run's newest.
 if cmp -s <(ls "$work/full/checkpoints") <(ls "$work/part/checkpoints"); then ok "dam_checkpoints_after_restart"
 else bad "dam_checkpoints_after_restart: $(ls "$work/part/checkpoints" | tr '\n' ' ')"; fi
+
+# 1b. The same with artificial bulk viscosity: its q_p is handed from one step to the next in
+# the Workspace, and the checkpoint carries it (without it the restart differs from its first
+# step on).
+sed 's/viscosity: 0.001}/viscosity: 0.001, bulk_viscosity: {}}/; s/^name: dam_barrier/name: dam_bv/' "$work/dam.yaml" > "$work/dam_bv.yaml"
+expect bv_full 0 'completed' -- "$surge" run "$work/dam_bv.yaml" --out "$work/bv_full" --progress quiet
+expect bv_stopped 130 'interrupted' -- "$surge" run "$work/dam_bv.yaml" --out "$work/bv_part" --progress quiet --stop-at-step 450
+bv_oldest=$(ls "$work"/bv_part/checkpoints/dam_bv_step_*.h5 | head -1)
+expect bv_restart 0 'completed' -- "$surge" run "$work/dam_bv.yaml" --restart "$bv_oldest" --progress quiet --threads 1
+expect bv_bitwise 0 'numeric datasets' -- $compare "$work/bv_full" "$work/bv_part" dam_bv
 
 # 2. A dynamic Bullet body: in flight (bit for bit) and resting on the floor (round-off).
 cat > "$work/box.yaml" <<'YAML'

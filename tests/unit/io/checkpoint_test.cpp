@@ -88,6 +88,13 @@ Checkpoint FullCheckpoint(size_t n) {
   s.groups = {{0, 0, n / 2}, {2, n / 2, n}};
   s.rigid = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
   c.bullet = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
+  c.bulk_viscosity_q.assign(n, 0);
+  c.bulk_viscosity_id.assign(n, 0);
+  for (size_t p = 0; p < n; ++p) {
+    c.bulk_viscosity_q[p] = u(rng);
+    c.bulk_viscosity_id[p] = int64_t(n - p);
+  }
+  c.bulk_viscosity_dt_bound = 2.5e-4;
   c.next_output = 0.15;
   c.next_checkpoint = 0.2;
   c.result.snapshots = 4;
@@ -142,6 +149,9 @@ TEST_F(CheckpointTest, RoundTripIsBitwise) {
     EXPECT_EQ(r.state.groups[1].end, n);
     EXPECT_TRUE(SameRigid(r.state.rigid, c.state.rigid));
     EXPECT_TRUE(SameRigid(r.bullet, c.bullet));
+    EXPECT_TRUE(SameBytes(r.bulk_viscosity_q, c.bulk_viscosity_q));
+    EXPECT_TRUE(SameBytes(r.bulk_viscosity_id, c.bulk_viscosity_id));
+    EXPECT_EQ(r.bulk_viscosity_dt_bound, 2.5e-4);
     EXPECT_EQ(r.next_output, 0.15);
     EXPECT_EQ(r.next_checkpoint, 0.2);
     EXPECT_EQ(r.result.snapshots, 4);
