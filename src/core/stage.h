@@ -12,6 +12,7 @@ enum class Stage : int {
   kGridUpdate,
   kObstacleContact,    // only with obstacles (src/contact)
   kBodyContact,        // only with body contacts: per-body velocity fields (src/transfer)
+  kLocalDamping,       // only with the scene key damping (src/transfer/grid_update.cpp)
   kGridToParticle,
   kRemapMomentum,      // MUSL only
   kVelocityGradient,   // MUSL only

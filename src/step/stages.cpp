@@ -37,6 +37,10 @@ void BodyContactStage(const Model& m, const StepContext& c, State&, Workspace& w
   ApplyBodyContact(m, c, w.grid, r.walls, r.body_contact);
 }
 
+void LocalDampingStage(const Model&, const StepContext& c, State&, Workspace& w, StepReport&) {
+  if (c.damping > 0) ApplyLocalDamping(c, w.grid);
+}
+
 void SensorsStage(const Model& m, const StepContext& c, State&, Workspace& w, StepReport& r) {
   SumSensors(m, c, w.grid, w.contact, r.sensors);
 }

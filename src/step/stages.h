@@ -15,6 +15,8 @@ void GridUpdateStage(const Model&, const StepContext&, State&, Workspace&, StepR
 // Node contact with the rigid obstacles on v_{n+1} (src/contact), reactions into the report.
 void ObstacleContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void BodyContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// Local damping of the free components of v_{n+1} while ctx.damping > 0 (src/transfer).
+void LocalDampingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Dynamic obstacles: the step's MPM reaction (force on the structure, torque about the centre of
 // mass) plus the ramped weight act on each Bullet body for dt, then State::rigid takes the new
 // poses and velocities (src/rigid; DESIGN §4 step 6).

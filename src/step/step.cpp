@@ -7,6 +7,8 @@
 //   then: DomainExit -> CheckState -> Energy
 //   AntiLocking (Mast 2013 Table 4.1) runs just before UpdateStress when a material asks for it.
 //   BulkViscosity (when a material has one): q_p after UpdateStress, sigma - q 1 around P2G.
+//   LocalDamping (scene key damping) after the grid update and the obstacles, on the free
+//   components of v_{n+1} (Anura3D manual §6.3).
 //   With obstacles: ObstacleContact after GridUpdate (node contact, reactions) and
 //   ObstacleProjection after the positions are committed (particles back onto the surface).
 //   With body contacts: BodyContact after the grid update and obstacles (per-body velocity
@@ -38,6 +40,7 @@ Pipeline MakePipeline(const Model& model) {
   const bool obstacles = !model.obstacles.empty();
   if (obstacles) p.push_back({Stage::kObstacleContact, ObstacleContactStage});  // spec §5.3
   if (model.field_count > 0) p.push_back({Stage::kBodyContact, BodyContactStage});  // Anura3D §6.2
+  if (model.damping.alpha > 0) p.push_back({Stage::kLocalDamping, LocalDampingStage});  // A3D (6.23)
   const bool antilocking = AnyAntiLocking(model);
   if (model.scheme == UpdateScheme::kUsl) {
     p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)

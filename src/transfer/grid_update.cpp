@@ -19,24 +19,6 @@ constexpr int kFaceSums = 7;
 constexpr int kWork = kFaceSums * kFaceCount, kMaxNodal = kWork + 1, kMaxElevation = kWork + 2;
 static_assert(kMaxElevation + 1 == std::tuple_size_v<SparseGrid::WallPartial>);
 
-namespace {
-
-// v_{n+1} with Cundall's local damping (Anura3D manual §6.3.1): m a = f + f_damp (6.22),
-// f_damp = -alpha |f| v/|v| per degree of freedom (6.23), f = f_ext - f_int the unbalanced nodal
-// force (gravity and tractions included). `a` is f/m; v = v_n, the nodal velocity at the start
-// of the step (a degree of freedom at rest is not damped). With alpha < 1 the damping force never
-// reverses the unbalanced force, so a node at rest under a load still accelerates.
-Vec3 DampedVelocity(const Vec3& v, const Vec3& a, Real alpha, Real dt) {
-  Vec3 out;
-  for (int d = 0; d < 3; ++d) {
-    const Real sign = v[d] > 0 ? 1 : (v[d] < 0 ? -1 : 0);
-    out[d] = v[d] + dt * (a[d] - alpha * std::abs(a[d]) * sign);  // (6.22)-(6.23)
-  }
-  return out;
-}
-
-}  // namespace
-
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report) {
   WallPlane walls[kFaceCount];
@@ -45,7 +27,6 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
   const Real g = model.gravity.norm();
   const Vec3 up = g > 0 ? Vec3(-model.gravity / g) : Vec3::UnitY();
   const bool keep_reaction = !model.sensors.empty();  // SparseGrid::reaction: sensors only
-  const Real damping = ctx.damping;  // local damping factor alpha, 0 = off (Anura3D (6.23))
   const size_t nb = grid.block_count();
   // Per-block partial reactions, summed in block order afterwards (deterministic).
   std::vector<SparseGrid::WallPartial>& partial = grid.wall_partials;
@@ -63,9 +44,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
         continue;
       }
       const Vec3 v = grid.momentum[i] / m;                        // (2.13)
-      const Vec3 vu = damping > 0 ? DampedVelocity(v, grid.force[i] / m + ctx.gravity, damping,
-                                                   ctx.dt)
-                                  : Vec3(v + ctx.dt * (grid.force[i] / m + ctx.gravity));  // (2.13)-(2.14)
+      const Vec3 vu = v + ctx.dt * (grid.force[i] / m + ctx.gravity);  // (2.13)-(2.14)
       grid.velocity[i] = v;
       Vec3 vc = vu;
       if (wall_count > 0) {
@@ -110,6 +89,33 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
     report.max_nodal_force = std::max(report.max_nodal_force, partial[b][kMaxNodal]);
     report.max_elevation = std::max(report.max_elevation, partial[b][kMaxElevation]);
   }
+}
+
+// Cundall's local damping (Anura3D manual §6.3.1): m a = f + f_damp (6.22), f_damp = -alpha |f|
+// v/|v| per degree of freedom (6.23), f = f_ext - f_int the unbalanced nodal force (gravity and
+// tractions included), v = v_n the nodal velocity at the start of the step (a component at rest
+// is not damped; with alpha < 1 the damping never reverses f). Only the components that no
+// constraint changed are damped: where a wall or an obstacle set v_{n+1} (v_{n+1,d} differs from
+// the free prediction v_n + dt (f/m + g)), the degree of freedom is prescribed, as a fixity is
+// in the manual, and its reaction (logged by the wall or obstacle) stays the undamped one.
+void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid) {
+  const Real alpha = ctx.damping;
+  ParallelFor(grid.block_count(), 4, [&](size_t b) {
+    for (int l = 0; l < kBlockNodes; ++l) {
+      const size_t i = b * kBlockNodes + l;
+      const Real m = grid.mass[i];
+      if (m <= 0) continue;
+      const Vec3& v = grid.velocity[i];
+      const Vec3 a = grid.force[i] / m + ctx.gravity;  // f/m
+      const Vec3 vu = v + ctx.dt * (grid.force[i] / m + ctx.gravity);  // as UpdateGridVelocity
+      Vec3& vn = grid.velocity_new[i];
+      for (int d = 0; d < 3; ++d) {
+        if (vn[d] != vu[d]) continue;  // constrained by a wall or an obstacle
+        const Real sign = v[d] > 0 ? 1 : (v[d] < 0 ? -1 : 0);
+        vn[d] = v[d] + ctx.dt * (a[d] - alpha * std::abs(a[d]) * sign);  // (6.22)-(6.23)
+      }
+    }
+  });
 }
 
 void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid) {

@@ -45,6 +45,12 @@ struct WallReport {
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report);
 
+// Local damping (Anura3D manual §6.3.1, (6.22)-(6.23); docs/antilocking.md) with the factor
+// ctx.damping on the components of v_{n+1} that no wall or obstacle constrained. Reads mass,
+// force, velocity (v_n); writes velocity_new. Pre: UpdateGridVelocity and the obstacle contact
+// ran this step, ctx.damping > 0.
+void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid);
+
 // Contact between MPM bodies of the last step (ApplyBodyContact).
 struct BodyContactReport {
   std::vector<Vec3> force;    // by velocity field: force the other bodies exert on it [N]
