@@ -1,8 +1,10 @@
 // G2P (Mast 2013 eq. (2.22)) and the particle velocity gradient (2.17). Each block gathers the
 // padded halo of its nodes once, then updates its particles; blocks are independent.
+#include <cstring>
 #include <type_traits>
 
 #include "core/parallel.h"
+#include "core/simd.h"
 #include "transfer/dispatch.h"
 #include "transfer/stencil_loop.h"
 #include "transfer/transfer.h"
@@ -83,30 +85,75 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
         for (int k = 0; k < (d < kDim ? st.W : 1); ++k) off[d][k] = (st.base[d] + k) * ctx.dx - x[d];
       constexpr bool kNeedB = kMode == G2PMode::kApic && !kApicUsesGradient<K>;
       const bool need_l = velocity_gradient || (kMode == G2PMode::kApic && kApicUsesGradient<K>);
+      // The kernel is a tensor product, so the sums separate: for each (i, j) the k sums
+      //   s0 = sum_k w_k v1,  s1 = sum_k g_k v1,  s2 = sum_k w_k oz_k v1,  sd = sum_k w_k (v1 - v0)
+      // are formed once and then weighted by the (i, j) factors, instead of forming every term of
+      // v_pic, L (2.17) and B per node (about half the multiplications of the per-node form).
+      Real wz_oz[Stencil<kDim, K>::W];
+      for (int k = 0; k < st.Wz; ++k) wz_oz[k] = st.w[2][k] * off[2][k];
+      // Lanes: each node velocity is loaded as (x, y) in a Real2 plus z as a scalar.
+      Real2 vpic2 = {0, 0}, dv2 = {0, 0}, bm2[3] = {}, l2[3] = {};  // x, y rows of the sums
       for (int i = 0; i < st.W; ++i)
         for (int j = 0; j < st.W; ++j) {
-          const Real wxy = st.w[0][i] * st.w[1][j];
-          const Real gxy_x = st.g[0][i] * st.w[1][j];
-          const Real gxy_y = st.w[0][i] * st.g[1][j];
           const Node* row = &field_halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
+          Real2 s0 = {0, 0}, s1 = {0, 0}, s2 = {0, 0}, sd = {0, 0};
+          Real s0z = 0, s1z = 0, s2z = 0, sdz = 0;
           for (int k = 0; k < st.Wz; ++k) {
-            const Real w = wxy * st.w[2][k];
-            const Real* v1 = row[k].v1;
-            for (int r = 0; r < 3; ++r) vpic[r] += w * v1[r];
-            if constexpr (kMode != G2PMode::kApic)
-              for (int r = 0; r < 3; ++r) dv[r] += w * (v1[r] - row[k].v0[r]);
+            Real2 v;
+            std::memcpy(&v, row[k].v1, sizeof v);
+            const Real vz = row[k].v1[2], wk = st.w[2][k];
+            s0 += wk * v;
+            s0z += wk * vz;
+            if constexpr (kMode != G2PMode::kApic) {
+              Real2 v0;
+              std::memcpy(&v0, row[k].v0, sizeof v0);
+              sd += wk * (v - v0);
+              sdz += wk * (vz - row[k].v0[2]);
+            }
             if constexpr (kNeedB) {
-              const Real o[3] = {off[0][i], off[1][j], off[2][k]};
-              for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c) bm[r][c] += w * v1[r] * o[c];
+              s2 += wz_oz[k] * v;
+              s2z += wz_oz[k] * vz;
             }
             if (need_l) {
-              const Real gr[3] = {gxy_x * st.w[2][k], gxy_y * st.w[2][k], wxy * st.g[2][k]};
-              for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c) l[r][c] += v1[r] * gr[c];
+              s1 += st.g[2][k] * v;
+              s1z += st.g[2][k] * vz;
             }
           }
+          const Real wxy = st.w[0][i] * st.w[1][j];
+          vpic2 += wxy * s0;
+          vpic[2] += wxy * s0z;
+          if constexpr (kMode != G2PMode::kApic) {
+            dv2 += wxy * sd;
+            dv[2] += wxy * sdz;
+          }
+          if constexpr (kNeedB) {
+            const Real bx = wxy * off[0][i], by = wxy * off[1][j];
+            bm2[0] += bx * s0;
+            bm2[1] += by * s0;
+            bm2[2] += wxy * s2;
+            bm[2][0] += bx * s0z;
+            bm[2][1] += by * s0z;
+            bm[2][2] += wxy * s2z;
+          }
+          if (need_l) {
+            // grad N = (g_i w_j w_k, w_i g_j w_k, w_i w_j g_k)
+            const Real gx = st.g[0][i] * st.w[1][j], gy = st.w[0][i] * st.g[1][j];
+            l2[0] += gx * s0;
+            l2[1] += gy * s0;
+            l2[2] += wxy * s1;
+            l[2][0] += gx * s0z;
+            l[2][1] += gy * s0z;
+            l[2][2] += wxy * s1z;
+          }
         }
+      for (int r = 0; r < 2; ++r) {
+        vpic[r] = vpic2[r];
+        dv[r] = dv2[r];
+        for (int c = 0; c < 3; ++c) {
+          bm[r][c] = bm2[c][r];
+          l[r][c] = l2[c][r];
+        }
+      }
       const Vec3 v_pic(vpic[0], vpic[1], vpic[2]);
       Mat3 L, B;
       for (int r = 0; r < 3; ++r)

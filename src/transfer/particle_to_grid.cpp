@@ -5,6 +5,7 @@
 
 #include "core/check.h"
 #include "core/parallel.h"
+#include "core/simd.h"
 #include "transfer/dispatch.h"
 #include "transfer/stencil_loop.h"
 #include "transfer/transfer.h"
@@ -12,8 +13,9 @@
 namespace surge {
 namespace {
 
+// Single field: the node sums as four two-lane vectors.
 struct NodeAccum {
-  Real m, px, py, pz, fx, fy, fz, pad;
+  Real2 v[4];  // (m, px), (py, pz), (fx, fy), (fz, unused)
 };
 // With per-body velocity fields: also the first mass moment sum_p m_p N_ip (x_p - x_i).
 struct FieldAccum {
@@ -86,52 +88,99 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
       neg_vs = -(P.volume0[p] * P.F[p].determinant()) * P.stress[p];
       fext = ctx.ramp * P.ext_force[p];  // particle tractions (App. B.2.9), ramped (App. B.2.3)
     }
-    // Terms that depend on (i, j) only are hoisted out of the k loop:
-    //   momentum  w (m v + mC (x_i - x_p)) = w (c_ij + mC[:,2] oz_k),  c_ij = m v + mC[:,0] ox_i + mC[:,1] oy_j
-    //   force     -V sigma grad N = w2_k a_ij + g2_k b_ij,  a_ij = S (gx_ij, gy_ij, 0), b_ij = wxy S[:,2]
+    // Lane vectors of the single-field path: (m, m v), the columns of mC as (0, mC[:,c]), the
+    // columns of -V sigma as (S[:,c], 0) and (f_ext, 0), each as two Real2.
+    const Real2 v_mv[2] = {{kFull ? m : 0.0, mv[0]}, {mv[1], mv[2]}};
+    Real2 v_mc[3][2], v_s[3][2];
+    const Real2 v_fext[2] = {{fext.x(), fext.y()}, {fext.z(), 0.0}};
+    for (int c = 0; c < 3; ++c) {
+      v_mc[c][0] = Real2{0.0, mC(0, c)};
+      v_mc[c][1] = Real2{mC(1, c), mC(2, c)};
+      v_s[c][0] = Real2{neg_vs(0, c), neg_vs(1, c)};
+      v_s[c][1] = Real2{neg_vs(2, c), 0.0};
+    }
+    // Terms that depend on (i, j) or on k only are hoisted out of the inner loop. With
+    // w = wxy w_k and oz_k = (x_i - x_p)_z:
+    //   momentum  w (m v + mC (x_i - x_p)) = w_k a_ij + (w_k oz_k) b_ij,
+    //             a_ij = wxy (m v + mC[:,0] ox_i + mC[:,1] oy_j),  b_ij = wxy mC[:,2]
+    //   force     -V sigma grad N + w f_ext = w_k fa_ij + g_k fb_ij,
+    //             fa_ij = S (gx_ij, gy_ij, 0) + wxy f_ext,  fb_ij = wxy S[:,2]
+    Real wk_oz[Stencil<kDim, K>::W];
+    for (int k = 0; k < st.Wz; ++k) wk_oz[k] = st.w[2][k] * off[2][k];
     for (int i = 0; i < st.W; ++i) {
       for (int j = 0; j < st.W; ++j) {
         const Real wxy = st.w[0][i] * st.w[1][j];
-        Real c[3] = {mv[0], mv[1], mv[2]};
+        const Real wm = wxy * m;
+        Real ca[3], cb[3] = {0, 0, 0};
+        for (int r = 0; r < 3; ++r) ca[r] = wxy * mv[r];
         if constexpr (kApic)
-          for (int r = 0; r < 3; ++r) c[r] += mC(r, 0) * off[0][i] + mC(r, 1) * off[1][j];
+          for (int r = 0; r < 3; ++r) {
+            ca[r] += wxy * (mC(r, 0) * off[0][i] + mC(r, 1) * off[1][j]);
+            cb[r] = wxy * mC(r, 2);
+          }
         Real fa[3] = {0, 0, 0}, fb[3] = {0, 0, 0};
         if constexpr (kFull) {
           const Real gx = st.g[0][i] * st.w[1][j], gy = st.w[0][i] * st.g[1][j];
           for (int r = 0; r < 3; ++r) {
-            fa[r] = neg_vs(r, 0) * gx + neg_vs(r, 1) * gy;
+            fa[r] = neg_vs(r, 0) * gx + neg_vs(r, 1) * gy + wxy * fext[r];
             fb[r] = wxy * neg_vs(r, 2);
           }
         }
         Accum* row = &field_buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
+        if constexpr (!kFields) {
+          // Node sums as lane updates: (m, p) += w_k (wm, a) + (w_k oz_k) (0, b),
+          // f += w_k fa + g_k fb, with the (i, j) vectors built from the per-particle vectors by
+          // lane-wise operations only (no element inserts in the loop).
+          const Real ox = off[0][i], oy = off[1][j];
+          const Real gx = st.g[0][i] * st.w[1][j], gy = st.w[0][i] * st.g[1][j];
+          Real2 a[4], b[4];
+          for (int h = 0; h < 2; ++h) {
+            a[h] = kApic ? wxy * (v_mv[h] + ox * v_mc[0][h] + oy * v_mc[1][h]) : wxy * v_mv[h];
+            b[h] = wxy * v_mc[2][h];
+            a[2 + h] = gx * v_s[0][h] + gy * v_s[1][h] + wxy * v_fext[h];
+            b[2 + h] = wxy * v_s[2][h];
+          }
+          for (int k = 0; k < st.Wz; ++k) {
+            const Real wk = st.w[2][k], wo = wk_oz[k], g2 = st.g[2][k];
+            Real2* n = row[k].v;
+            for (int h = 0; h < 2; ++h) {
+              if constexpr (kApic)
+                n[h] += wk * a[h] + wo * b[h];  // APIC (Jiang et al. 2015, eq. (9))
+              else
+                n[h] += wk * a[h];
+              if constexpr (kFull) n[2 + h] += wk * a[2 + h] + g2 * b[2 + h];  // (2.11) + traction
+            }
+          }
+          continue;
+        }
         for (int k = 0; k < st.Wz; ++k) {
-          const Real w = wxy * st.w[2][k];
+          const Real wk = st.w[2][k];
           Accum& a = row[k];
-          if constexpr (kApic) {
-            // APIC: m_p (v_p + C_p (x_i - x_p)) (Jiang et al. 2015, eq. (9)).
-            const Real oz = off[2][k];
-            a.px += w * (c[0] + mC(0, 2) * oz);
-            a.py += w * (c[1] + mC(1, 2) * oz);
-            a.pz += w * (c[2] + mC(2, 2) * oz);
-          } else {
-            a.px += w * c[0];
-            a.py += w * c[1];
-            a.pz += w * c[2];
-          }
-          if constexpr (kFull) {
-            // Internal force -V_p sigma_p grad N_ip (2.11) plus the traction share w f_ext.
-            const Real w2 = st.w[2][k], g2 = st.g[2][k];
-            a.m += w * m;
-            a.fx += w2 * fa[0] + g2 * fb[0] + w * fext.x();
-            a.fy += w2 * fa[1] + g2 * fb[1] + w * fext.y();
-            a.fz += w2 * fa[2] + g2 * fb[2] + w * fext.z();
-          }
           if constexpr (kFields) {
+            if constexpr (kApic) {
+              // APIC: m_p (v_p + C_p (x_i - x_p)) (Jiang et al. 2015, eq. (9)).
+              const Real wo = wk_oz[k];
+              a.px += wk * ca[0] + wo * cb[0];
+              a.py += wk * ca[1] + wo * cb[1];
+              a.pz += wk * ca[2] + wo * cb[2];
+            } else {
+              a.px += wk * ca[0];
+              a.py += wk * ca[1];
+              a.pz += wk * ca[2];
+            }
+            if constexpr (kFull) {
+              // Internal force -V_p sigma_p grad N_ip (2.11) plus the traction share w f_ext.
+              const Real g2 = st.g[2][k];
+              a.m += wk * wm;
+              a.fx += wk * fa[0] + g2 * fb[0];
+              a.fy += wk * fa[1] + g2 * fb[1];
+              a.fz += wk * fa[2] + g2 * fb[2];
+            }
             // First mass moment w m_p (x_p - x_i) of the particle's field (contact normals).
-            const Real wm = w * m;
-            a.gx -= wm * off[0][i];
-            a.gy -= wm * off[1][j];
-            a.gz -= wm * off[2][k];
+            const Real w = wxy * wk, wmk = w * m;
+            a.gx -= wmk * off[0][i];
+            a.gy -= wmk * off[1][j];
+            a.gz -= wmk * off[2][k];
           }
         }
       }
@@ -144,15 +193,16 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
       for (int b = 0; b < Pad::E; ++b)
         for (int c = 0; c < Pad::Ez; ++c) {
           const NodeAccum& n = buf[Pad::Index(a, b, c)];
-          if (n.m == 0 && n.px == 0 && n.py == 0 && n.pz == 0 && n.fx == 0 && n.fy == 0 && n.fz == 0)
+          if (n.v[0][0] == 0 && n.v[0][1] == 0 && n.v[1][0] == 0 && n.v[1][1] == 0 &&
+              n.v[2][0] == 0 && n.v[2][1] == 0 && n.v[3][0] == 0)
             continue;
           const long g = PaddedToGrid(grid, blk, a, b, c);
           SURGE_ASSERT(g >= 0);
           if (g < 0) continue;
-          grid.momentum[g] += Vec3(n.px, n.py, n.pz);
+          grid.momentum[g] += Vec3(n.v[0][1], n.v[1][0], n.v[1][1]);
           if constexpr (kFull) {
-            grid.mass[g] += n.m;
-            grid.force[g] += Vec3(n.fx, n.fy, n.fz);
+            grid.mass[g] += n.v[0][0];
+            grid.force[g] += Vec3(n.v[2][0], n.v[2][1], n.v[3][0]);
           }
         }
   }
