@@ -10,6 +10,7 @@ HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_
   const Mat3 b_trial = Sym(f * elastic_b * f.transpose());  // (3.35)
   Eigen::SelfAdjointEigenSolver<Mat3> eig(b_trial);
   HenckyTrial t;
+  t.b = b_trial;
   t.Q = eig.eigenvectors();
   t.eps = 0.5 * eig.eigenvalues().array().log();  // (3.34), erratum 2
   t.tau = HenckyStress(K, G, t.eps);
@@ -28,8 +29,12 @@ Vec3 HenckyStrain(Real K, Real G, const Vec3& tau) {
 
 void HenckyFinish(const HenckyTrial& t, Real K, Real G, const Vec3& tau, Real J,
                   Mat3& elastic_b, Mat3& stress) {
-  const Vec3 eps_e = HenckyStrain(K, G, tau);
-  elastic_b = FromPrincipal(t.Q, (2.0 * eps_e).array().exp().matrix());  // Table 3.4, 5(c)
+  if (tau == t.tau) {
+    elastic_b = t.b;  // elastic step: b^e_{n+1} = b^e_tr
+  } else {
+    const Vec3 eps_e = HenckyStrain(K, G, tau);
+    elastic_b = FromPrincipal(t.Q, (2.0 * eps_e).array().exp().matrix());  // Table 3.4, 5(c)
+  }
   stress = FromPrincipal(t.Q, tau) / J;                                   // 5(d), (3.37)
 }
 

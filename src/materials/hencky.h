@@ -14,6 +14,7 @@ namespace surge {
 
 // Trial state in the eigenbasis of b^e_tr = f b^e_n f^T (3.35).
 struct HenckyTrial {
+  Mat3 b;    // b^e_tr = f b^e_n f^T (3.35)
   Mat3 Q;    // eigenvectors of b^e_tr (columns): the principal directions n^(i)
   Vec3 eps;  // principal trial Hencky strains eps_i = 1/2 ln b_i (3.34), erratum 2
   Vec3 tau;  // principal trial Kirchhoff stresses [C^e_d] eps (Table 3.4, step 4) [Pa]
@@ -30,7 +31,9 @@ Vec3 HenckyStress(Real K, Real G, const Vec3& eps);
 Vec3 HenckyStrain(Real K, Real G, const Vec3& tau);
 
 // Steps 5(c)-(d) of Table 3.4 and (3.37): b^e_{n+1} = sum exp(2 eps^e_i) m^(i) with
-// eps^e = [D^e_d] tau, and sigma_{n+1} = (sum tau_i m^(i)) / J.
+// eps^e = [D^e_d] tau, and sigma_{n+1} = (sum tau_i m^(i)) / J. An elastic step (tau is the
+// trial stress, bitwise) keeps b^e_{n+1} = b^e_tr, which the formula reproduces in exact
+// arithmetic (eps^e = eps_tr, exp(2 eps_tr,i) = b_i), without the exponentials.
 void HenckyFinish(const HenckyTrial& trial, Real K, Real G, const Vec3& tau, Real J,
                   Mat3& elastic_b, Mat3& stress);
 
