@@ -6,6 +6,10 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "scene/scene.h"
@@ -110,6 +114,119 @@ BENCHMARK_CAPTURE(BM_Step, quadratic_apic_box_obstacle, "quadratic_bspline", "ap
 BENCHMARK_CAPTURE(BM_Step, quadratic_apic_mesh_obstacle, "quadratic_bspline", "apic", kRubber,
                   kMeshObstacle)
     ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+// --- Column collapse at a given particle count (performance issue): a column 1 x 2 x 1 (3-D) or
+// 1 x 2 (2-D) in cells, 2 particles per cell per axis, dx = 0.02 m, standing in the corner of
+// slip symmetry walls on a frictional floor (the soil with a K0 = 0.5 geostatic start), released at
+// t = 0 (seed §7.2 set-up). Arguments: particle count, threads. Counters add the exact bytes per
+// particle of State + Workspace (vector capacities, grid included) and the process RSS per particle.
+
+constexpr const char* kWater =
+    "{model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e6, viscosity: 1.0e-3}";
+
+std::string ColumnScene(int dim, double particles, const char* material, bool geostatic) {
+  const double dx = 0.02, ppc = dim == 3 ? 8 : 4;
+  // cells = n * 2n (* n): n = (N / (2 ppc))^(1/dim)
+  const double n = std::round(std::pow(particles / (2 * ppc), 1.0 / dim));
+  const double w = n * dx, h = 2 * n * dx;
+  auto num = [](double v) { return std::to_string(v); };
+  const std::string zmin = dim == 3 ? ", 0]" : "]", zmax = dim == 3 ? ", " + num(w) + "]" : "]";
+  const std::string dmax = dim == 3 ? ", " + num(3 * w) + "]" : "]";
+  return std::string("name: bench_column\ndimension: ") + std::to_string(dim) + R"(
+time: {end: 100.0, cfl: 0.4}
+gravity: )" + (dim == 3 ? "[0, -9.81, 0]" : "[0, -9.81]") + R"(
+grid: {cell_size: )" + num(dx) + R"(, shape_function: quadratic_bspline, transfer: apic}
+domain:
+  min: )" + (dim == 3 ? "[0, 0, 0]" : "[0, 0]") + R"(
+  max: [)" + num(3 * w) + ", " + num(1.2 * h + 4 * dx) + dmax + R"(
+  walls: )" + (dim == 3 ? "{x-: slip, z-: slip, y-: {friction: 0.5}, x+: slip, z+: slip}"
+                       : "{x-: slip, y-: {friction: 0.5}, x+: slip}") + R"(
+materials:
+  soil: )" + std::string(material) + R"(
+bodies:
+  - name: column
+    material: soil
+    region: {box: {min: )" + (dim == 3 ? "[0, 0, 0]" : "[0, 0]") + ", max: [" + num(w) + ", " +
+         num(h) + zmax + R"(}}
+    particles_per_cell: 2
+)" + (geostatic ? "    initial_stress: {geostatic: {k0: 0.5}}\n" : "") +
+         "output: {every: 0, energy: false}\n";
+}
+
+size_t ResidentBytes() {
+  long pages = 0, resident = 0;
+  if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+    std::fclose(f);
+  }
+  return size_t(resident) * size_t(sysconf(_SC_PAGESIZE));
+}
+
+template <class T>
+size_t Bytes(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+
+// Bytes held by the particle arrays and the step's scratch (grid included).
+size_t StateBytes(const State& state, const Workspace& w) {
+  const Particles& P = state.particles;
+  size_t b = Bytes(P.x) + Bytes(P.v) + Bytes(P.C) + Bytes(P.F) + Bytes(P.stress) +
+             Bytes(P.strain) + Bytes(P.elastic_b) + Bytes(P.history) + Bytes(P.mass) +
+             Bytes(P.volume0) + Bytes(P.ext_force) + Bytes(P.material) + Bytes(P.body) +
+             Bytes(P.id);
+  const SparseGrid& g = w.grid;
+  b += Bytes(g.block_origin) + Bytes(g.neighbor) + Bytes(g.particle_block) +
+       Bytes(g.block_begin) + Bytes(g.sorted) + Bytes(g.mass) + Bytes(g.momentum) +
+       Bytes(g.force) + Bytes(g.velocity) + Bytes(g.velocity_new) + Bytes(g.reaction) +
+       Bytes(g.particle_block_coord) + Bytes(g.requests) + Bytes(g.chunk_cursor) +
+       Bytes(g.wall_partials);
+  for (const auto& c : g.colour) b += Bytes(c);
+  for (const auto& c : g.chunk_requests) b += Bytes(c);
+  b += Bytes(w.velocity_gradient) + Bytes(w.x_new) + Bytes(w.exit_flag) + Bytes(w.reorder);
+  return b;
+}
+
+void BM_Column(benchmark::State& bm, int dim, const char* material) {
+  const double wanted = double(bm.range(0));
+  const int threads = int(bm.range(1));
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  LoadedScene scene =
+      LoadSceneFromString(ColumnScene(dim, wanted, material, material == kSmoothCap), "bench_column.yaml");
+  const Pipeline pipeline = MakePipeline(scene.model);
+  Workspace work;
+  StepReport report;
+  for (int i = 0; i < 2; ++i) Step(scene.model, pipeline, scene.state, work, report);  // warm-up
+  report.stage_seconds.fill(0);
+  const size_t n = scene.state.particles.size();
+  int64_t steps = 0;
+  for (auto _ : bm) {
+    Step(scene.model, pipeline, scene.state, work, report);
+    ++steps;
+  }
+  bm.counters["particles"] = double(n);
+  bm.counters["updates_per_s"] =
+      benchmark::Counter(double(n) * double(steps), benchmark::Counter::kIsRate);
+  bm.counters["bytes_per_particle"] = double(StateBytes(scene.state, work)) / double(n);
+  bm.counters["rss_per_particle"] = double(ResidentBytes()) / double(n);
+  for (int s = 0; s < kStageCount; ++s)
+    if (report.stage_seconds[s] > 0)
+      bm.counters[std::string("ms_") + StageName(Stage(s))] =
+          1e3 * report.stage_seconds[s] / double(steps);
+}
+
+void ColumnArgs(benchmark::internal::Benchmark* b) {
+  for (int64_t n : {10000, 100000, 1000000})
+    for (int64_t t : {1, 2}) b->Args({n, t});
+  b->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+}
+
+BENCHMARK_CAPTURE(BM_Column, dp_3d, 3, kSmoothCap)->Apply(ColumnArgs);
+BENCHMARK_CAPTURE(BM_Column, dp_3d_4M, 3, kSmoothCap)
+    ->Args({4000000, 1})->Args({4000000, 2})->Iterations(3)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Column, dp_2d, 2, kSmoothCap)->Apply(ColumnArgs);
+BENCHMARK_CAPTURE(BM_Column, elastic_3d, 3, kRubber)->Apply(ColumnArgs);
+BENCHMARK_CAPTURE(BM_Column, water_3d, 3, kWater)->Apply(ColumnArgs);
 
 }  // namespace
 }  // namespace surge
