@@ -5,9 +5,21 @@
 // interval is part of the reproducibility contract (it changes summation order).
 #include <vector>
 
+#include "core/parallel.h"
+
 #include "step/stages.h"
 
 namespace surge {
+namespace {
+
+template <class T>
+void Permute(std::vector<T>& a, const std::vector<uint32_t>& order) {
+  std::vector<T> permuted(a.size());
+  ParallelFor(a.size(), 4096, [&](size_t i) { permuted[i] = a[order[i]]; });
+  a.swap(permuted);
+}
+
+}  // namespace
 
 void ReorderParticlesStage(const Model&, const StepContext&, State& s, Workspace& w, StepReport&) {
   if (s.step % kReorderInterval != 0) return;
@@ -28,26 +40,17 @@ void ReorderParticlesStage(const Model&, const StepContext&, State& s, Workspace
     order[cursor[g]++] = p;
   }
   if (identity) return;
-  // Apply new[i] = old[order[i]] in place by following cycles, with slot n as the temporary.
-  std::vector<uint8_t>& done = w.exit_flag;
-  done.assign(n, 0);
-  P.Resize(n + 1);
-  for (size_t start = 0; start < n; ++start) {
-    if (done[start] || order[start] == start) continue;
-    P.Move(n, start);
-    size_t j = start;
-    while (true) {
-      done[j] = 1;
-      const size_t k = order[j];
-      if (k == start) {
-        P.Move(j, n);
-        break;
-      }
-      P.Move(j, k);
-      j = k;
-    }
-  }
-  P.Resize(n);
+  // Apply new[i] = old[order[i]] array by array: a parallel gather into a fresh array that then
+  // replaces the old one. It streams each array once and holds one extra array at a time (the
+  // serial cycle-following Move it replaces touched all 14 arrays per particle, on one thread).
+  static_assert(sizeof(Particles) == 14 * sizeof(std::vector<Real>),
+                "a new Particles array must be permuted here too");
+  for (auto* a : {&P.x, &P.v, &P.ext_force}) Permute(*a, order);
+  for (auto* a : {&P.C, &P.F, &P.stress, &P.strain, &P.elastic_b}) Permute(*a, order);
+  for (auto* a : {&P.mass, &P.volume0}) Permute(*a, order);
+  for (auto* a : {&P.material, &P.body}) Permute(*a, order);
+  Permute(P.history, order);
+  Permute(P.id, order);
   // The grid binning follows the particles.
   std::vector<int32_t>& block = grid.particle_block;
   std::vector<int32_t> old_block(block);
