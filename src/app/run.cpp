@@ -53,7 +53,10 @@ std::string FormatDuration(double s) {
 
 class Progress {
  public:
-  Progress(ProgressMode mode, Real end_time) : end_time_(end_time) {
+  // start_time: the simulated time the run starts from (a restart's checkpoint time), so that the
+  // ETA extrapolates from this run's own speed.
+  Progress(ProgressMode mode, Real end_time, Real start_time = 0)
+      : end_time_(end_time), start_time_(start_time) {
     if (mode == ProgressMode::kAuto) mode = isatty(STDERR_FILENO) ? ProgressMode::kTerminal : ProgressMode::kPlain;
     mode_ = mode;
     start_ = last_ = Clock::now();
@@ -67,7 +70,7 @@ class Progress {
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double steps_per_s = (step - last_step_) / std::max(since, 1e-9);
     const double updates = steps_per_s * double(particles);
-    const double eta = t > 0 ? elapsed * (end_time_ - t) / t : -1;
+    const double eta = t > start_time_ ? elapsed * (end_time_ - t) / (t - start_time_) : -1;
     const std::string line = fmt::format(
         "t = {:.4g}/{:.4g} s ({:5.1f}%)  step {}  {:.1f} steps/s  {:.2f} M particle-updates/s  "
         "elapsed {}  ETA {}",
@@ -90,6 +93,7 @@ class Progress {
   using Clock = std::chrono::steady_clock;
   ProgressMode mode_;
   Real end_time_;
+  Real start_time_;
   Clock::time_point start_, last_;
   int64_t last_step_ = 0;
   bool printed_ = false;
@@ -229,7 +233,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
     work.bulk_viscosity.dt_bound = resume.bulk_viscosity_dt_bound;
   }
   StepReport report;
-  Progress progress(options.progress, model.time.end);
+  Progress progress(options.progress, model.time.end, state.time);
 
   g_interrupted.store(false);
   auto previous = std::signal(SIGINT, OnSigint);
