@@ -26,6 +26,10 @@ static_assert(sizeof(Vec3) == 3 * sizeof(double) && sizeof(Mat3) == 9 * sizeof(d
               "Eigen fixed-size types must be packed");
 static_assert(sizeof(History) == kHistorySlots * sizeof(double), "History must be packed");
 static_assert(std::is_same_v<Real, double>, "checkpoints store Real as float64");
+// Particles has exactly the 14 arrays written and read below: a new array must be added here
+// (and to docs/results-format.md, "Checkpoints") or restarts silently lose it.
+static_assert(sizeof(Particles) == 14 * sizeof(std::vector<Real>),
+              "Particles changed: update WriteCheckpoint/ReadCheckpoint");
 
 // Owns an hid_t and closes it with the matching H5*close (as in hdf5_writer.cpp).
 class Handle {
