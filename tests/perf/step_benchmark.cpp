@@ -40,6 +40,13 @@ constexpr const char* kBoxObstacle = R"(obstacles:
     shape: {box: {min: [0.95, -2, -2], max: [1.5, 3, 3]}}
     contact: {friction: 0.3}
 )";
+// Configured but never reached: a box 5 m below the block's path (shows that the obstacle stages
+// cost next to nothing when no block is near an obstacle).
+constexpr const char* kFarObstacle = R"(obstacles:
+  - name: far_wall
+    shape: {box: {min: [-1, -8, -1], max: [3, -7, 3]}}
+    contact: {friction: 0.3}
+)";
 const std::string kMeshObstacle = std::string(R"(obstacles:
   - name: mound
     shape: {mesh: {file: )") + SURGE_SOURCE_DIR + R"(/assets/mound.obj, scale: 0.3, rotate_deg: [0, 0, 90], translate: [1.9, 0.45, 0.45]}}
@@ -110,6 +117,9 @@ BENCHMARK_CAPTURE(BM_Step, quadratic_apic_mn_dp, "quadratic_bspline", "apic", kM
 // (stages obstacle_contact, obstacle_projection) on top of the plain block.
 BENCHMARK_CAPTURE(BM_Step, quadratic_apic_box_obstacle, "quadratic_bspline", "apic", kRubber,
                   kBoxObstacle)
+    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_Step, quadratic_apic_far_obstacle, "quadratic_bspline", "apic", kRubber,
+                  kFarObstacle)
     ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 BENCHMARK_CAPTURE(BM_Step, quadratic_apic_mesh_obstacle, "quadratic_bspline", "apic", kRubber,
                   kMeshObstacle)
