@@ -278,16 +278,25 @@ int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ct
   }
   scratch.moved.resize(kReductionChunks);
   for (auto& m : scratch.moved) m.clear();
-  ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
+  // Broad phase, once per block: the block or one of the upper neighbours its particles'
+  // stencils reach was near an obstacle. With no such block (material far from every obstacle)
+  // the pass over the particles is skipped: a configured obstacle the flow never reaches costs
+  // one pass over the blocks.
+  const size_t nb = grid.block_count();
+  std::vector<uint8_t> near_owner(nb, 0);
+  bool any_near = false;
+  for (size_t blk = 0; blk < nb; ++blk) {
+    bool near = scratch.near_block[blk] != 0;
+    for (int k = 1; k < 8 && !near; ++k) {
+      const int32_t nbk = grid.neighbor[blk][k];
+      near = nbk >= 0 && scratch.near_block[size_t(nbk)] != 0;
+    }
+    near_owner[blk] = near;
+    any_near |= near;
+  }
+  if (any_near) ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
     for (size_t p = b; p < e; ++p) {
-      // Broad phase: the particle's block or one its stencil reaches was near an obstacle.
-      const int32_t blk = grid.particle_block[p];
-      bool near = scratch.near_block[size_t(blk)] != 0;
-      for (int k = 1; k < 8 && !near; ++k) {
-        const int32_t nbk = grid.neighbor[size_t(blk)][k];
-        near = nbk >= 0 && scratch.near_block[size_t(nbk)] != 0;
-      }
-      if (!near) continue;
+      if (!near_owner[size_t(grid.particle_block[p])]) continue;
       for (size_t o = 0; o < no; ++o) {
         Vec3& x = P.x[p];
         bool in_box = true;
