@@ -236,7 +236,10 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   Progress progress(options.progress, model.time.end, state.time);
 
   g_interrupted.store(false);
+  // Ctrl-C, and SIGTERM (what a batch scheduler such as Slurm sends at the time limit), both
+  // finish the step, write a checkpoint and flush the results.
   auto previous = std::signal(SIGINT, OnSigint);
+  auto previous_term = std::signal(SIGTERM, OnSigint);
 
   auto write_snapshot = [&]() {
     writer.WriteSnapshot(state);
@@ -365,6 +368,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   progress.Update(state.time, state.step, state.particles.size(), /*force=*/true);
   progress.Finish();
   std::signal(SIGINT, previous);
+  std::signal(SIGTERM, previous_term);
   write_snapshot();
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.steps = state.step;

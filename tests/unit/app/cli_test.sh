@@ -125,4 +125,17 @@ if [ "$rc" -eq 130 ] && grep -q interrupted "$work/int.log" && [ -f "$work/int/e
 else
   echo "FAIL sigint: exit $rc"; tail -3 "$work/int.log"; fail=$((fail + 1))
 fi
+# SIGTERM (a batch scheduler's time limit) is handled the same way.
+"$surge" run "$src/scenes/elastic_drop_3d.yaml" --out "$work/term" --progress quiet > "$work/term.log" 2>&1 &
+pid=$!
+sleep 2
+kill -TERM $pid
+wait $pid
+rc=$?
+if [ "$rc" -eq 130 ] && grep -q interrupted "$work/term.log" \
+  && ls "$work"/term/checkpoints/elastic_drop_3d_step_*.h5 > /dev/null 2>&1; then
+  echo "ok   sigterm"; pass=$((pass + 1))
+else
+  echo "FAIL sigterm: exit $rc"; tail -3 "$work/term.log"; fail=$((fail + 1))
+fi
 finish cli
