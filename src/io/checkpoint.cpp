@@ -5,6 +5,8 @@
 
 #include <hdf5.h>
 
+#include "io/h5_handle.h"
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -31,22 +33,7 @@ static_assert(std::is_same_v<Real, double>, "checkpoints store Real as float64")
 static_assert(sizeof(Particles) == 14 * sizeof(std::vector<Real>),
               "Particles changed: update WriteCheckpoint/ReadCheckpoint");
 
-// Owns an hid_t and closes it with the matching H5*close (as in hdf5_writer.cpp).
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-  bool ok() const { return id_ >= 0; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
+using Handle = H5Handle;  // io/h5_handle.h
 
 void Require(bool ok, const std::string& what, const std::string& path) {
   if (!ok) throw IoError("checkpoint '" + path + "': cannot " + what);

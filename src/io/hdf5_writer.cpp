@@ -4,6 +4,8 @@
 // docs/results-format.md. The XDMF sidecar is written by xdmf.cpp from the snapshot list kept here.
 #include <hdf5.h>
 
+#include "io/h5_handle.h"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
@@ -27,22 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Owns an hid_t and closes it with the matching H5*close.
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-  bool ok() const { return id_ >= 0; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
+using Handle = H5Handle;  // io/h5_handle.h
 
 // The innermost message on the HDF5 error stack of the last failed call (it names the cause,
 // e.g. "unable to open file: ... errno = 13, error message = 'Permission denied'").
