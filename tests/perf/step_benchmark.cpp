@@ -74,16 +74,12 @@ output: {every: 0, energy: false}
 )" + obstacles;
 }
 
-void BM_Step(benchmark::State& bm, const char* shape, const char* transfer,
-             const char* material = kRubber, const std::string& obstacles = kNoObstacles) {
-  const int threads = int(bm.range(0));
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  LoadedScene scene = LoadSceneFromString(BlockScene(shape, transfer, material, obstacles),
-                                          "bench_block.yaml");
+// Takes `warmup` untimed steps, then times whole Step() calls; counters: particles,
+// particle-updates per second and milliseconds per stage.
+void TimeSteps(benchmark::State& bm, LoadedScene& scene, Workspace& work, int warmup) {
   const Pipeline pipeline = MakePipeline(scene.model);
-  Workspace work;
   StepReport report;
-  for (int i = 0; i < 3; ++i) Step(scene.model, pipeline, scene.state, work, report);  // warm-up
+  for (int i = 0; i < warmup; ++i) Step(scene.model, pipeline, scene.state, work, report);
   report.stage_seconds.fill(0);
   const size_t n = scene.state.particles.size();
   int64_t steps = 0;
@@ -92,10 +88,22 @@ void BM_Step(benchmark::State& bm, const char* shape, const char* transfer,
     ++steps;
   }
   bm.counters["particles"] = double(n);
-  bm.counters["updates_per_s"] = benchmark::Counter(double(n) * double(steps), benchmark::Counter::kIsRate);
+  bm.counters["updates_per_s"] =
+      benchmark::Counter(double(n) * double(steps), benchmark::Counter::kIsRate);
   for (int s = 0; s < kStageCount; ++s)
     if (report.stage_seconds[s] > 0)
-      bm.counters[std::string("ms_") + StageName(Stage(s))] = 1e3 * report.stage_seconds[s] / double(steps);
+      bm.counters[std::string("ms_") + StageName(Stage(s))] =
+          1e3 * report.stage_seconds[s] / double(steps);
+}
+
+void BM_Step(benchmark::State& bm, const char* shape, const char* transfer,
+             const char* material = kRubber, const std::string& obstacles = kNoObstacles) {
+  const int threads = int(bm.range(0));
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  LoadedScene scene = LoadSceneFromString(BlockScene(shape, transfer, material, obstacles),
+                                          "bench_block.yaml");
+  Workspace work;
+  TimeSteps(bm, scene, work, 3);
 }
 
 BENCHMARK_CAPTURE(BM_Step, quadratic_apic, "quadratic_bspline", "apic")
@@ -202,26 +210,11 @@ void BM_Column(benchmark::State& bm, int dim, const char* material) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   LoadedScene scene =
       LoadSceneFromString(ColumnScene(dim, wanted, material, material == kSmoothCap), "bench_column.yaml");
-  const Pipeline pipeline = MakePipeline(scene.model);
   Workspace work;
-  StepReport report;
-  for (int i = 0; i < 2; ++i) Step(scene.model, pipeline, scene.state, work, report);  // warm-up
-  report.stage_seconds.fill(0);
-  const size_t n = scene.state.particles.size();
-  int64_t steps = 0;
-  for (auto _ : bm) {
-    Step(scene.model, pipeline, scene.state, work, report);
-    ++steps;
-  }
-  bm.counters["particles"] = double(n);
-  bm.counters["updates_per_s"] =
-      benchmark::Counter(double(n) * double(steps), benchmark::Counter::kIsRate);
-  bm.counters["bytes_per_particle"] = double(StateBytes(scene.state, work)) / double(n);
-  bm.counters["rss_per_particle"] = double(ResidentBytes()) / double(n);
-  for (int s = 0; s < kStageCount; ++s)
-    if (report.stage_seconds[s] > 0)
-      bm.counters[std::string("ms_") + StageName(Stage(s))] =
-          1e3 * report.stage_seconds[s] / double(steps);
+  TimeSteps(bm, scene, work, 2);
+  const double n = double(scene.state.particles.size());
+  bm.counters["bytes_per_particle"] = double(StateBytes(scene.state, work)) / n;
+  bm.counters["rss_per_particle"] = double(ResidentBytes()) / n;
 }
 
 void ColumnArgs(benchmark::internal::Benchmark* b) {

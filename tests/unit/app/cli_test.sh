@@ -112,30 +112,22 @@ expect run_small 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" -
 expect run_vdb 0 'completed' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/vdb" --set time.end=0.05 --set output.vdb=true --progress quiet
 if ls "$work"/vdb/two_disks_2d_grid_*.vdb > /dev/null 2>&1; then echo "ok   vdb_files"; pass=$((pass + 1)); else echo "FAIL vdb_files"; fail=$((fail + 1)); fi
 expect run_unwritable 1 'cannot create results folder' -- "$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/out/two_disks_2d.h5/sub" --set time.end=0.01
-# Ctrl-C: the run finishes the step, writes a checkpoint, flushes results and exits 130.
-"$surge" run "$src/scenes/elastic_drop_3d.yaml" --out "$work/int" --progress quiet > "$work/int.log" 2>&1 &
-pid=$!
-sleep 2
-kill -INT $pid
-wait $pid
-rc=$?
-if [ "$rc" -eq 130 ] && grep -q interrupted "$work/int.log" && [ -f "$work/int/elastic_drop_3d.xmf" ] \
-  && ls "$work"/int/checkpoints/elastic_drop_3d_step_*.h5 > /dev/null 2>&1; then
-  echo "ok   sigint"; pass=$((pass + 1))
-else
-  echo "FAIL sigint: exit $rc"; tail -3 "$work/int.log"; fail=$((fail + 1))
-fi
-# SIGTERM (a batch scheduler's time limit) is handled the same way.
-"$surge" run "$src/scenes/elastic_drop_3d.yaml" --out "$work/term" --progress quiet > "$work/term.log" 2>&1 &
-pid=$!
-sleep 2
-kill -TERM $pid
-wait $pid
-rc=$?
-if [ "$rc" -eq 130 ] && grep -q interrupted "$work/term.log" \
-  && ls "$work"/term/checkpoints/elastic_drop_3d_step_*.h5 > /dev/null 2>&1; then
-  echo "ok   sigterm"; pass=$((pass + 1))
-else
-  echo "FAIL sigterm: exit $rc"; tail -3 "$work/term.log"; fail=$((fail + 1))
-fi
+# Ctrl-C, and SIGTERM (a batch scheduler's time limit): the run finishes the step, writes a
+# checkpoint, flushes results and exits 130.
+check_signal() {  # name signal
+  "$surge" run "$src/scenes/elastic_drop_3d.yaml" --out "$work/$1" --progress quiet > "$work/$1.log" 2>&1 &
+  local pid=$!
+  sleep 2
+  kill -"$2" $pid
+  wait $pid
+  local rc=$?
+  if [ "$rc" -eq 130 ] && grep -q interrupted "$work/$1.log" && [ -f "$work/$1/elastic_drop_3d.xmf" ] \
+    && ls "$work/$1"/checkpoints/elastic_drop_3d_step_*.h5 > /dev/null 2>&1; then
+    echo "ok   $1"; pass=$((pass + 1))
+  else
+    echo "FAIL $1: exit $rc"; tail -3 "$work/$1.log"; fail=$((fail + 1))
+  fi
+}
+check_signal sigint INT
+check_signal sigterm TERM
 finish cli
