@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Compares two Surge results folders bit for bit (tests/regression/restart_test.sh).
 
-Usage: compare_results.py DIR_A DIR_B NAME [--tolerance REL]
+Usage: compare_results.py DIR_A DIR_B NAME [--tolerance REL] [--ignore-attr KEY ...]
 
 Compares <dir>/<NAME>.h5 (every numeric dataset by its bytes, every attribute except the
 wall-clock ones in /timing and the root's command_line and start_time_utc), every CSV and the .xmf of DIR_A byte for byte with DIR_B's, and
@@ -56,6 +56,8 @@ def main():
     ap.add_argument("b")
     ap.add_argument("name")
     ap.add_argument("--tolerance", type=float, default=None)
+    ap.add_argument("--ignore-attr", action="append", default=[],
+                    help="attribute key to skip, e.g. @threads (repeatable)")
     args = ap.parse_args()
     diffs = []
     worst = 0.0
@@ -85,7 +87,8 @@ def main():
                     diffs.append(f"{p}: differs from row {rows[0] if len(rows) else '?'}")
         aa, ab = attributes(fa), attributes(fb)
         for key in sorted(set(aa) | set(ab)):
-            if key.startswith("timing@") or key in ("@command_line", "@start_time_utc"):
+            if key.startswith("timing@") or key in ("@command_line", "@start_time_utc") \
+                    or key in args.ignore_attr:
                 continue  # wall-clock seconds of the stages; how and when the run was started
             if aa.get(key) != ab.get(key):
                 if args.tolerance is not None and key.startswith("forces/"):
