@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Reproducibility from the result file alone (issue 9, item 4; ctest label regression): a run on
-# 2 threads records the scene verbatim (/metadata/scene), the resolved scene, version, git hash
+# Reproducibility from the result file alone (issue 9, item 4; ctest label regression): a run of
+# the small dam break against a barrier (tests/data/scenes/dam_barrier_small_2d.yaml) on 2 threads records the scene verbatim (/metadata/scene), the resolved scene, version, git hash
 # and thread count; the scene text taken back out of that file and run on 1 thread gives the same
 # result bit for bit (every numeric dataset, the force series, CSVs, .xmf, summary.json; only the
 # thread count, the scene path, the command line and wall-clock attributes may differ).
@@ -11,22 +11,7 @@ src=$2
 . "$src/tests/support/cli_checks.sh"
 compare="/usr/bin/python3 $src/tests/regression/compare_results.py"
 
-cat > "$work/dam.yaml" <<'YAML'
-name: dam_barrier
-dimension: 2
-time: {end: 0.15, cfl: 0.3}
-gravity: [0, -9.81]
-grid: {cell_size: 0.02}
-domain: {min: [0, 0], max: [1.0, 0.5], walls: {x-: slip, x+: slip, y-: {friction: 0.3}, y+: slip}}
-materials:
-  water: {model: newtonian_fluid, density: 1000, bulk_modulus: 6.0e5, viscosity: 0.001}
-bodies:
-  - {name: water, material: water, region: {box: {min: [0, 0], max: [0.3, 0.3]}}, particles_per_cell: 2}
-obstacles:
-  - name: barrier
-    shape: {box: {min: [0.6, 0], max: [0.66, 0.2]}}
-output: {every: 0.05}
-YAML
+cp "$src/tests/data/scenes/dam_barrier_small_2d.yaml" "$work/dam.yaml"
 expect first_run 0 'completed' -- "$surge" run "$work/dam.yaml" --out "$work/a" --threads 2 --progress quiet
 /usr/bin/python3 - "$work/a/dam_barrier.h5" "$work/from_file.yaml" > "$work/meta.txt" <<'PY'
 import sys, h5py
