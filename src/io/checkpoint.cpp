@@ -15,6 +15,9 @@
 #include <filesystem>
 #include <type_traits>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 namespace surge {
 namespace {
 
@@ -37,6 +40,18 @@ using Handle = H5Handle;  // io/h5_handle.h
 
 void Require(bool ok, const std::string& what, const std::string& path) {
   if (!ok) throw IoError("checkpoint '" + path + "': cannot " + what);
+}
+
+// fsync(2) of a file or folder: hands its data (a folder: its entries) to the disk, so that after
+// an operating-system crash or power cut the renamed checkpoint is whole, not an empty or partly
+// written file under the final name (a killed process needs no fsync: the page cache survives it).
+void SyncPath(const std::string& path, bool folder) {
+  const int fd = ::open(path.c_str(), (folder ? O_DIRECTORY : 0) | O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError("checkpoint: cannot open '" + path + "' to sync it: " + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) throw IoError("checkpoint: cannot sync '" + path + "': " + std::strerror(err));
 }
 
 // --- writing ---
@@ -344,8 +359,12 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
     }
     Require(H5Fflush(f, H5F_SCOPE_GLOBAL) >= 0, "flush the file", tmp);
   }
+  // Whole on disk before it gets its final name, and the rename itself on disk after it: the
+  // write-fsync-rename-fsync(folder) sequence of an atomic replace.
+  SyncPath(tmp, false);
   fs::rename(tmp, path, ec);
   if (ec) throw IoError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+  SyncPath(dir.empty() ? std::string(".") : dir.string(), true);
 }
 
 Checkpoint ReadCheckpoint(const std::string& path) {
