@@ -28,7 +28,8 @@ struct Aabb {
 // assimp mesh (OBJ `o`/`g` group, glTF mesh, STL solid) becomes a part; meshes with the same name
 // share one part, unnamed ones are called "part<k>" (k = the part's index). part/part_names are
 // always filled.
-// Throws std::runtime_error naming the file if it cannot be read or holds no triangles.
+// Throws std::runtime_error naming the file if it is not a regular file, cannot be read, holds
+// no triangles, a non-finite vertex or a face index out of range.
 TriangleMesh ReadTriangleMesh(const std::string& path);
 
 // Axis-aligned bounding box of the vertices. Pre: the mesh has at least one vertex.

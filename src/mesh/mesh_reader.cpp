@@ -5,6 +5,8 @@
 
 #include <array>
 #include <assimp/Importer.hpp>
+#include <cmath>
+#include <filesystem>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -15,6 +17,7 @@ namespace surge {
 namespace {
 
 struct Builder {
+  std::string path;  // for error messages
   const aiScene* scene = nullptr;
   TriangleMesh mesh;
   std::map<std::array<double, 3>, int> welded;   // vertex position -> index
@@ -39,6 +42,14 @@ struct Builder {
     std::vector<int> index(am.mNumVertices);
     for (unsigned v = 0; v < am.mNumVertices; ++v) {
       const aiVector3D a = transform * am.mVertices[v];
+      // A NaN or infinite coordinate (an OBJ "v nan 0 0", a float overflow like 1e999) would
+      // break the weld map's ordering and every later geometric test: reject the file.
+      if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(a.z)) {
+        throw std::runtime_error("mesh file '" + path + "': vertex " + std::to_string(v + 1) +
+                                 " of mesh '" + am.mName.C_Str() + "' is not finite (" +
+                                 std::to_string(a.x) + ", " + std::to_string(a.y) + ", " +
+                                 std::to_string(a.z) + ")");
+      }
       const std::array<double, 3> key = {a.x, a.y, a.z};
       const auto [it, inserted] = welded.try_emplace(key, static_cast<int>(mesh.vertices.size()));
       if (inserted) mesh.vertices.emplace_back(a.x, a.y, a.z);
@@ -47,6 +58,14 @@ struct Builder {
     for (unsigned f = 0; f < am.mNumFaces; ++f) {
       const aiFace& face = am.mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines
+      for (unsigned k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= am.mNumVertices) {
+          throw std::runtime_error("mesh file '" + path + "': face " + std::to_string(f + 1) +
+                                   " of mesh '" + am.mName.C_Str() + "' refers to vertex " +
+                                   std::to_string(face.mIndices[k] + 1) + " of " +
+                                   std::to_string(am.mNumVertices));
+        }
+      }
       mesh.triangles.push_back(
           {index[face.mIndices[0]], index[face.mIndices[1]], index[face.mIndices[2]]});
       mesh.part.push_back(part);
@@ -57,6 +76,10 @@ struct Builder {
   void AddNode(const aiNode& node, const aiMatrix4x4& parent) {
     const aiMatrix4x4 transform = parent * node.mTransformation;
     for (unsigned i = 0; i < node.mNumMeshes; ++i) {
+      if (node.mMeshes[i] >= scene->mNumMeshes || scene->mMeshes[node.mMeshes[i]] == nullptr) {
+        throw std::runtime_error("mesh file '" + path + "': node '" + node.mName.C_Str() +
+                                 "' refers to a mesh that is not in the file");
+      }
       AddMesh(*scene->mMeshes[node.mMeshes[i]], transform);
     }
     for (unsigned c = 0; c < node.mNumChildren; ++c) AddNode(*node.mChildren[c], transform);
@@ -66,6 +89,14 @@ struct Builder {
 }  // namespace
 
 TriangleMesh ReadTriangleMesh(const std::string& path) {
+  // Only regular files (or links to one): assimp would block forever reading a named pipe and
+  // read a device such as /dev/zero without end.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    const bool exists = std::filesystem::exists(path, ec);
+    throw std::runtime_error("cannot read mesh file '" + path + "': " +
+                             (exists ? "not a regular file" : "no such file"));
+  }
   Assimp::Importer importer;
   // No aiProcess_PreTransformVertices: it joins meshes that share a material, which would merge
   // the parts. The node transforms are applied in Builder::AddNode instead.
@@ -76,6 +107,7 @@ TriangleMesh ReadTriangleMesh(const std::string& path) {
     throw std::runtime_error("cannot read mesh file '" + path + "': " + importer.GetErrorString());
   }
   Builder builder;
+  builder.path = path;
   builder.scene = scene;
   builder.AddNode(*scene->mRootNode, aiMatrix4x4());
   if (builder.mesh.triangles.empty()) {
