@@ -144,6 +144,17 @@ void RemoveCheckpoints(const std::string& out_dir, const std::string& name,
   }
 }
 
+// <out>/checkpoints/<name>_failed_step_<step, 9 digits>.h5: the diagnostic checkpoint a health
+// stop writes (the state of the failed step, docs/stability.md). ListCheckpoints does not list it,
+// so it is never rotated away nor offered for --restart.
+std::string FailedCheckpointPath(const std::string& out_dir, const std::string& name, int64_t step) {
+  return fmt::format("{}/checkpoints/{}_failed_step_{:09}.h5", out_dir, name, step);
+}
+
+bool IsFailedCheckpoint(const std::string& path) {
+  return std::filesystem::path(path).filename().string().find("_failed_step_") != std::string::npos;
+}
+
 // Refuses a new run over an existing result unless options.force, and clears the old result's
 // checkpoints (they would continue a run that is being overwritten).
 void PrepareNewRun(const Model& model, const RunOptions& options) {
@@ -158,10 +169,24 @@ void PrepareNewRun(const Model& model, const RunOptions& options) {
                                 " to continue it"));
   }
   RemoveCheckpoints(options.out_dir, model.name, "");
+  // and the old result's diagnostic checkpoint of a failed step, if any
+  const std::filesystem::path dir = std::filesystem::path(options.out_dir) / "checkpoints";
+  const std::string prefix = model.name + "_failed_step_";
+  if (std::filesystem::is_directory(dir, ec)) {
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+      if (e.path().filename().string().rfind(prefix, 0) == 0) std::filesystem::remove(e.path(), ec);
+    }
+  }
 }
 
 // Reads options.restart and checks that it was written from this scene with these overrides.
 Checkpoint ReadMatchingCheckpoint(const LoadedScene& scene, const RunOptions& options) {
+  if (IsFailedCheckpoint(options.restart)) {
+    throw RunRefused("'" + options.restart + "' is the diagnostic checkpoint of a failed step (the "
+                     "state that failed the health check), not a state to continue from; restart "
+                     "from a periodic checkpoint (<name>_step_<step>.h5) or run again with the "
+                     "remedy the stop message names");
+  }
   Checkpoint c;
   try {
     c = ReadCheckpoint(options.restart);
@@ -278,9 +303,11 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   // Writes a checkpoint of the state after the last completed step (docs/results-format.md,
   // "Checkpoints") and keeps the newest output.checkpoints_keep. A failure is a warning: the
   // run and its results go on.
-  auto write_checkpoint = [&]() {
+  // diagnostic: the failed state of a health stop (FailedCheckpointPath; not rotated).
+  auto write_checkpoint = [&](bool diagnostic = false) {
     const auto t0 = std::chrono::steady_clock::now();
-    const std::string path = CheckpointPath(options.out_dir, model.name, state.step);
+    const std::string path = diagnostic ? FailedCheckpointPath(options.out_dir, model.name, state.step)
+                                        : CheckpointPath(options.out_dir, model.name, state.step);
     Checkpoint c;
     c.result = writer.Flush();
     c.next_output = next_output;
@@ -309,31 +336,44 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
       return;
     }
     state = std::move(c.state);
-    const std::vector<std::string> all = ListCheckpoints(options.out_dir, model.name);
+    const std::vector<std::string> all =
+        diagnostic ? std::vector<std::string>{} : ListCheckpoints(options.out_dir, model.name);
     for (size_t k = 0; k + size_t(model.output.checkpoints_keep) < all.size(); ++k) {
       std::error_code ec;
       std::filesystem::remove(all[k], ec);
     }
     std::error_code ec;
     const double mb = double(std::filesystem::file_size(path, ec)) / 1e6;
-    LogInfo(fmt::format("checkpoint {} ({:.1f} MB, {:.2f} s)", path, ec ? 0.0 : mb,
+    LogInfo(fmt::format("{} {} ({:.1f} MB, {:.2f} s)",
+                        diagnostic ? "diagnostic checkpoint of the failed step (for inspection, "
+                                     "not for --restart):"
+                                   : "checkpoint",
+                        path, ec ? 0.0 : mb,
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
   };
   const auto start = std::chrono::steady_clock::now();
   double particle_steps = 0;
   const Real end_tolerance = 1e-12 * model.time.end;
+  bool unhealthy = false;
   summary.exit_status = "completed";
   while (state.time < model.time.end - end_tolerance) {
     const size_t n = state.particles.size();
     Step(model, pipeline, state, work, report);
     if (report.health.status != HealthStatus::kOk) {
+      // Health stop (docs/stability.md): the message names the step, the stage, the field, the
+      // particle and the likely cause; the failed state goes to a diagnostic checkpoint, and the
+      // results keep only the healthy snapshots and series (no final snapshot of the failed state).
+      unhealthy = true;
+      const Health& h = report.health;
       summary.exit_code = kExitUnhealthy;
       summary.exit_status = "stopped at t = " + fmt::format("{:.6g}", state.time) + " s, step " +
-                            std::to_string(state.step) + ": " + report.health.detail +
-                            (report.health.particle_id >= 0
-                                 ? " (particle id " + std::to_string(report.health.particle_id) + ")"
-                                 : "");
+                            std::to_string(state.step) +
+                            (h.stage.empty() ? "" : ", stage " + h.stage) +
+                            (h.field.empty() ? "" : ", field " + h.field) + ": " + h.detail;
       LogError(summary.exit_status);
+      write_checkpoint(/*diagnostic=*/true);
+      const std::vector<std::string> good = ListCheckpoints(options.out_dir, model.name);
+      if (!good.empty()) LogInfo("last periodic checkpoint (a healthy state): " + good.back());
       break;
     }
     particle_steps += double(n);
@@ -369,7 +409,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   progress.Finish();
   std::signal(SIGINT, previous);
   std::signal(SIGTERM, previous_term);
-  write_snapshot();
+  if (!unhealthy) write_snapshot();
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.steps = state.step;
   summary.end_time = state.time;

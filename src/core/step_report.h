@@ -23,7 +23,9 @@ enum class HealthStatus { kOk, kNonFinite, kInvertedElement, kLeftDomain, kTimeS
 struct Health {
   HealthStatus status = HealthStatus::kOk;
   int64_t particle_id = -1;  // first offender (seeding id)
-  std::string detail;        // field and value, for the diagnostic
+  std::string detail;        // field and value, the particle, the likely cause: the diagnostic
+  std::string stage;         // the stage that produced the bad value (StageName), or "time_step"
+  std::string field;         // "v", "x", "F", "J", "stress", "dt"
 };
 
 }  // namespace surge

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -203,10 +204,20 @@ void DomainExitStage(const Model& m, const StepContext&, State& s, Workspace& w,
   if (std::find(any.begin(), any.end(), 1) == any.end()) return;
   if (m.exit_policy == ExitPolicy::kStop) {
     const size_t p = size_t(std::find(w.exit_flag.begin(), w.exit_flag.end(), 1) - w.exit_flag.begin());
+    const size_t count = size_t(std::count(w.exit_flag.begin(), w.exit_flag.end(), 1));
+    const std::string body =
+        size_t(P.body[p]) < m.bodies.size() ? m.bodies[size_t(P.body[p])].name : "?";
     r.health = Health{HealthStatus::kLeftDomain, P.id[p],
-                      "particle left the domain through an open side at x = (" +
+                      "particle id " + std::to_string(P.id[p]) + " (material '" +
+                          m.materials[size_t(P.material[p])].name + "', body '" + body +
+                          "') left the domain through an open side: position x = (" +
                           std::to_string(P.x[p].x()) + ", " + std::to_string(P.x[p].y()) + ", " +
-                          std::to_string(P.x[p].z()) + ") and domain.on_exit is 'stop'"};
+                          std::to_string(P.x[p].z()) + ") at |v| = " + std::to_string(P.v[p].norm()) +
+                          " m/s, found by stage domain_exit; " + std::to_string(count) +
+                          " particles outside. Likely cause: the flow reaches an open side and "
+                          "domain.on_exit is 'stop': enlarge the domain, close that side with a "
+                          "wall, or set domain.on_exit: remove",
+                      "domain_exit", "x"};
     return;
   }
   // Stable compaction; material groups shrink accordingly.
@@ -226,35 +237,155 @@ void DomainExitStage(const Model& m, const StepContext&, State& s, Workspace& w,
   P.Resize(out);
 }
 
-// NaN/Inf in x, v or stress, and J <= 0; records the first offender in particle order.
-void CheckStateStage(const Model&, const StepContext&, State& s, Workspace&, StepReport& r) {
+namespace {
+// The particle fields the health check reads, in the order a step writes them: v and x in
+// grid_to_particle, F in grid_to_particle (USL) or velocity_gradient (MUSL), stress in
+// update_stress. Every field was finite and J > 0 at the end of the previous step (the check runs
+// every step), so the earliest bad field in this order names the stage that produced it.
+enum BadField : int { kFieldOk = 0, kFieldV, kFieldX, kFieldF, kFieldJ, kFieldStress, kFieldCount };
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+std::string Point(const Vec3& x, int dim) {
+  std::string s = "(" + Num(x.x()) + ", " + Num(x.y());
+  if (dim == 3) s += ", " + Num(x.z());
+  return s + ")";
+}
+
+// The diagnostic of a failed health check (failure path only): the field and stage, the particle
+// with its material and body, and the likely cause from the time step against the CFL limit
+// dt <= C h / (c + |v|) (spec §1.7) of the stiffest material present.
+void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, size_t p, int field,
+                       size_t count, Health& h) {
   const Particles& P = s.particles;
-  std::array<size_t, kReductionChunks> first;
-  first.fill(std::numeric_limits<size_t>::max());
-  std::array<int, kReductionChunks> kind{};
+  const Material& mat = m.materials[size_t(P.material[p])];
+  const std::string body =
+      size_t(P.body[p]) < m.bodies.size() ? m.bodies[size_t(P.body[p])].name : "?";
+  const bool antilocked = size_t(P.material[p]) < m.antilocking.size() &&
+                          m.antilocking[size_t(P.material[p])].method != AntiLockingMethod::kNone;
+  // Stiffest material with particles: its wave speed bounds the stable step from above.
+  Real c_max = 0;
+  std::string stiffest;
+  for (const MaterialGroup& g : s.groups) {
+    if (g.end == g.begin) continue;
+    const Real c = WaveSpeed(m.materials[size_t(g.material)]);
+    if (c > c_max) c_max = c, stiffest = m.materials[size_t(g.material)].name;
+  }
+  const Real dt_wave = c_max > 0 ? ctx.dx / c_max : 0;  // CFL limit at rest (C = 1) [s]
+  const Real courant = c_max > 0 ? ctx.dt * c_max / ctx.dx : 0;
+  const Real speed = P.v[p].allFinite() ? P.v[p].norm() : std::numeric_limits<Real>::infinity();
+  const Real J = P.F[p].allFinite() ? P.F[p].determinant() : std::numeric_limits<Real>::quiet_NaN();
+  const bool musl = m.scheme == UpdateScheme::kMusl;
+
+  switch (field) {
+    case kFieldV:
+      h.field = "v";
+      h.stage = "grid_to_particle";
+      h.detail = "non-finite velocity v";
+      break;
+    case kFieldX:
+      h.field = "x";
+      h.stage = m.obstacles.empty() ? "grid_to_particle" : "grid_to_particle or obstacle_projection";
+      h.detail = "non-finite position x (velocity finite, |v| = " + Num(speed) + " m/s)";
+      break;
+    case kFieldF:
+      h.field = "F";
+      h.stage = musl ? "velocity_gradient" : "grid_to_particle";
+      if (antilocked) h.stage += " or anti_locking";
+      h.detail = "non-finite deformation gradient F (v and x finite, |v| = " + Num(speed) + " m/s)";
+      break;
+    case kFieldJ:
+      h.field = "J";
+      h.stage = musl ? "velocity_gradient" : "grid_to_particle";
+      if (antilocked) h.stage += " or anti_locking";
+      h.detail = "inverted particle, det F = J = " + Num(J) + " <= 0 (|v| = " + Num(speed) + " m/s)";
+      break;
+    default:
+      h.field = "stress";
+      h.stage = "update_stress";
+      h.detail = "non-finite stress from a finite F (J = " + Num(J) + ", |v| = " + Num(speed) +
+                 " m/s): the constitutive update failed";
+      break;
+  }
+  h.detail += " at particle id " + std::to_string(P.id[p]) + " (material '" + mat.name +
+              "', body '" + body + "', x = " +
+              (P.x[p].allFinite() ? Point(P.x[p], m.dim) : std::string("non-finite")) +
+              "), produced by stage " + h.stage + "; " + std::to_string(count) + " of " +
+              std::to_string(P.size()) + " particles unhealthy. ";
+
+  // Likely cause.
+  const std::string cfl_text = "dt = " + Num(ctx.dt) + " s against the CFL limit h/c = " +
+                               Num(dt_wave) + " s of material '" + stiffest +
+                               "' (c = " + Num(c_max) + " m/s, h = " + Num(ctx.dx) +
+                               " m): Courant number " + Num(courant);
+  std::string cause;
+  if (m.time.fixed_dt > 0 && courant > 1) {
+    cause = "time.fixed_dt is above the CFL limit: " + cfl_text +
+            " > 1. Remove time.fixed_dt (the automatic dt obeys the limit) or set it below " +
+            Num(m.time.cfl * dt_wave) + " s.";
+  } else if (courant > 1) {
+    cause = "dt above the CFL limit: " + cfl_text + " > 1 (time.max_dt or a viscous bound did not " +
+            "cap it). Lower time.cfl.";
+  } else if (field == kFieldStress) {
+    cause = "material '" + mat.name + "' could not be updated at this deformation (J = " + Num(J) +
+            "); " + cfl_text + " (within the limit). Check its parameters; for impacts add " +
+            "bulk_viscosity to it, or lower time.cfl.";
+  } else if (field == kFieldJ) {
+    cause = "the particle was compressed through zero volume in one step (velocity gradient x dt "
+            ">= 1) although " + cfl_text + " is within the limit: an impact or a collapse faster "
+            "than the grid resolves, or a node with tiny mass (an isolated particle at a cell "
+            "edge). Add bulk_viscosity to material '" + mat.name + "' for shocks, or lower "
+            "time.cfl (e.g. to 0.2).";
+  } else {
+    cause = "an instability that the CFL rule does not cover (" + cfl_text +
+            " is within the limit): a node with tiny mass (isolated particles), a contact or "
+            "an unstable material setting. Lower time.cfl (e.g. to 0.2); for shocks add "
+            "bulk_viscosity.";
+  }
+  h.detail += "Likely cause: " + cause;
+}
+}  // namespace
+
+// Health check (DESIGN §4 item 7): NaN/Inf in v, x, F or stress, and J = det F <= 0. The healthy
+// path is one pass over the particles; the diagnostic (DescribeUnhealthy) runs only on failure.
+void CheckStateStage(const Model& m, const StepContext& ctx, State& s, Workspace&, StepReport& r) {
+  const Particles& P = s.particles;
+  constexpr size_t kNone = std::numeric_limits<size_t>::max();
+  std::array<std::array<size_t, kFieldCount>, kReductionChunks> first;
+  for (auto& f : first) f.fill(kNone);
+  std::array<size_t, kReductionChunks> bad{};
   ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
     for (size_t p = b; p < e; ++p) {
-      const bool finite = P.x[p].allFinite() && P.v[p].allFinite() && P.stress[p].allFinite();
-      const Real J = P.F[p].determinant();
-      if (!finite || !(J > 0)) {
-        first[chunk] = p;
-        kind[chunk] = finite ? 2 : 1;
-        return;
-      }
+      int field = kFieldOk;
+      if (!P.v[p].allFinite()) field = kFieldV;
+      else if (!P.x[p].allFinite()) field = kFieldX;
+      else if (!P.F[p].allFinite()) field = kFieldF;
+      else if (!(P.F[p].determinant() > 0)) field = kFieldJ;
+      else if (!P.stress[p].allFinite()) field = kFieldStress;
+      if (field == kFieldOk) continue;
+      ++bad[chunk];
+      if (first[chunk][size_t(field)] == kNone) first[chunk][size_t(field)] = p;
     }
   });
-  for (size_t c = 0; c < kReductionChunks; ++c) {
-    if (first[c] == std::numeric_limits<size_t>::max()) continue;
-    const size_t p = first[c];
-    if (kind[c] == 1) {
-      r.health = Health{HealthStatus::kNonFinite, P.id[p],
-                        "non-finite position, velocity or stress (time step too large for the "
-                        "material, or an unstable setup)"};
-    } else {
-      r.health = Health{HealthStatus::kInvertedElement, P.id[p],
-                        "det F = " + std::to_string(P.F[p].determinant()) + " <= 0 (inverted particle)"};
+  size_t count = 0;
+  for (size_t c : bad) count += c;
+  if (count == 0) return;
+  // The offender: the earliest field in step order, then the lowest index (thread-independent).
+  for (int field = kFieldV; field < kFieldCount; ++field) {
+    for (size_t c = 0; c < kReductionChunks; ++c) {
+      const size_t p = first[c][size_t(field)];
+      if (p == kNone) continue;
+      Health h;
+      h.status = field == kFieldJ ? HealthStatus::kInvertedElement : HealthStatus::kNonFinite;
+      h.particle_id = P.id[p];
+      DescribeUnhealthy(m, ctx, s, p, field, count, h);
+      r.health = std::move(h);
+      return;
     }
-    return;
   }
 }
 

@@ -82,7 +82,11 @@ void Step(const Model& model, const Pipeline& pipeline, State& state, Workspace&
   ctx.damping = model.damping.At(state.time);  // Anura3D §6.3: alpha, 0 after damping.until
   if (!(ctx.dt >= model.time.min_dt) || !std::isfinite(ctx.dt)) {
     report.health = Health{HealthStatus::kTimeStepTooSmall, -1,
-                           "time step " + std::to_string(ctx.dt) + " s is below time.min_dt"};
+                           "time step " + std::to_string(ctx.dt) + " s is below time.min_dt = " +
+                               std::to_string(model.time.min_dt) +
+                               " s. Likely cause: a particle speed |v| far above the wave speed "
+                               "(a blow-up in progress), or a viscous or bulk-viscosity bound",
+                           "time_step", "dt"};
     return;
   }
 

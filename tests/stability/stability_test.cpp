@@ -1,0 +1,307 @@
+// The stability suite (issue 8 item 2; docs/stability.md). Every scene of scenes/stress/ runs to
+// its end with the default time settings (automatic dt, Courant number 0.4) and must show, at
+// every step: no NaN/Inf and no J <= 0 (the health check), and where it applies no particle in
+// or behind the obstacle, and a total mechanical energy E = kinetic + strain + gravitational that
+// never grows by more than 1 % of its initial value (gravity measured from the domain's lowest
+// corner) in the scenes where nothing does external work (fixed walls and obstacles only, no
+// particles leaving). Cases made to fail must stop with exit code 3, a message naming the step,
+// stage, field, particle, material and likely cause, a diagnostic checkpoint, and results that
+// hold no snapshot of the failed state.
+//
+// Each case prints one line (the table of docs/stability.md): particles, steps, dt against the
+// CFL limit h / max(c + |v|) (spec §1.7) taken from the state at the start of each step, the
+// smallest J, the energy growth and the wall time. Each test runs on one thread, so that ctest
+// can run two at a time on two cores.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "app/run.h"
+#include "io/checkpoint.h"
+#include "step/stages.h"
+#include "support/obstacle_checks.h"
+#include "support/run_scene.h"
+
+namespace surge {
+namespace {
+
+std::string StressScene(const std::string& name) {
+  return std::string(SURGE_SOURCE_DIR) + "/scenes/stress/" + name + ".yaml";
+}
+
+struct CaseOptions {
+  bool energy = true;  // false where work is done on the system or mass leaves it
+  // Particles must stay at x <= behind_x (the front face of an obstacle hit from x-); NaN: none.
+  Real behind_x = std::numeric_limits<Real>::quiet_NaN();
+};
+
+struct CaseResult {
+  Health health;
+  int64_t steps = 0;
+  size_t particles = 0;
+  int64_t removed = 0;
+  Real dt_min = std::numeric_limits<Real>::infinity(), dt_max = 0;
+  Real limit_at_dt_min = 0;  // the CFL limit h / max(c + |v|) of the step with the smallest dt
+  Real courant_max = 0;      // largest dt / (h / max(c + |v|)) over the steps
+  Real min_j = std::numeric_limits<Real>::infinity();
+  Real energy_growth = 0;    // max_t (E(t) - E(0)) / E(0), E from the domain's lowest corner
+  Real energy_end = 0;       // (E(end) - E(0)) / E(0): the dissipated share when negative
+  Real max_penetration = 0;  // deepest particle inside an obstacle [m]
+  Real max_behind = -std::numeric_limits<Real>::infinity();  // max x - behind_x [m]
+  double wall_seconds = 0;
+};
+
+// Gravitational energy of all particles at the domain's lowest corner: E is measured from there,
+// so that E(0) is the energy the run could at most release.
+Real FloorPotential(const Model& m, const Particles& P) {
+  Real lowest = std::numeric_limits<Real>::infinity();
+  for (int c = 0; c < (m.dim == 3 ? 8 : 4); ++c) {
+    const Vec3 corner((c & 1) ? m.domain_max.x() : m.domain_min.x(),
+                      (c & 2) ? m.domain_max.y() : m.domain_min.y(),
+                      (c & 4) ? m.domain_max.z() : m.domain_min.z());
+    lowest = std::min(lowest, -m.gravity.dot(corner));  // potential per kg, -g.x
+  }
+  Real mass = 0;
+  for (Real mp : P.mass) mass += mp;
+  return mass * lowest;
+}
+
+Real Mechanical(const EnergyRecord& e) { return e.kinetic + e.strain + e.gravitational; }
+
+CaseResult RunCase(const std::string& name, const CaseOptions& opt,
+                   const std::vector<std::string>& overrides = {}) {
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const auto t0 = std::chrono::steady_clock::now();
+  LoadedScene scene = LoadScene(StressScene(name), overrides);
+  const Model& m = scene.model;
+  State& s = scene.state;
+  CaseResult r;
+  r.particles = s.particles.size();
+  const Pipeline pipeline = MakePipeline(m);
+  Workspace work;
+  StepReport report;
+  const Real floor = FloorPotential(m, s.particles);
+  const Real e0 = Mechanical(ComputeEnergy(m, s)) - floor;
+  Real e_max = e0, e_end = e0;
+  std::vector<Real> c(m.materials.size());
+  for (size_t k = 0; k < c.size(); ++k) c[k] = WaveSpeed(m.materials[k]);
+  while (s.time < m.time.end * (1 - 1e-12)) {
+    // The CFL limit at the start of the step (the state NextTimeStep reads).
+    Real speed = 0;
+    for (size_t p = 0; p < s.particles.size(); ++p)
+      speed = std::max(speed, c[size_t(s.particles.material[p])] + s.particles.v[p].norm());
+    const Real limit = m.dx / speed;
+    Step(m, pipeline, s, work, report);
+    if (report.health.status != HealthStatus::kOk) {
+      r.health = report.health;
+      break;
+    }
+    ++r.steps;
+    // The last step is cut to land on time.end: left out of the dt range.
+    if (s.time < m.time.end * (1 - 1e-12)) {
+      if (s.dt < r.dt_min) r.dt_min = s.dt, r.limit_at_dt_min = limit;
+      r.dt_max = std::max(r.dt_max, s.dt);
+      r.courant_max = std::max(r.courant_max, s.dt / limit);
+    }
+    for (const Mat3& F : s.particles.F) r.min_j = std::min(r.min_j, F.determinant());
+    if (opt.energy) {
+      e_end = Mechanical(ComputeEnergy(m, s)) - floor;
+      e_max = std::max(e_max, e_end);
+    }
+    if (!m.obstacles.empty()) r.max_penetration = std::max(r.max_penetration, testing::MaxPenetration(scene));
+    if (!std::isnan(opt.behind_x)) {
+      for (const Vec3& x : s.particles.x) r.max_behind = std::max(r.max_behind, x.x() - opt.behind_x);
+    }
+  }
+  r.removed = s.particles_removed;
+  r.energy_growth = (e_max - e0) / e0;
+  r.energy_end = (e_end - e0) / e0;
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  char energy[64] = "n/a";
+  if (opt.energy)
+    std::snprintf(energy, sizeof energy, "max %+.3g %%, end %+.3g %%", 100 * r.energy_growth,
+                  100 * r.energy_end);
+  std::printf("[stability] %-26s %6zu particles %7lld steps  dt %.3g..%.3g s  CFL limit %.3g s  "
+              "dt/limit <= %.3f  min J %.4f  energy %s  removed %lld  wall %.1f s\n",
+              name.c_str(), r.particles, static_cast<long long>(r.steps), r.dt_min, r.dt_max,
+              r.limit_at_dt_min, r.courant_max, r.min_j, energy,
+              static_cast<long long>(r.removed), r.wall_seconds);
+  return r;
+}
+
+// The checks every healthy case shares. The automatic dt is C = 0.4 of the CFL limit, or less
+// where a viscous bound governs: never more.
+void ExpectStable(const CaseResult& r, const CaseOptions& opt) {
+  EXPECT_EQ(r.health.status, HealthStatus::kOk) << r.health.detail;
+  EXPECT_GT(r.steps, 0);
+  EXPECT_LE(r.courant_max, 0.4 * (1 + 1e-9));
+  EXPECT_GT(r.min_j, 0.0);
+  if (opt.energy) {
+    EXPECT_LE(r.energy_growth, 0.01);
+  }
+  EXPECT_LE(r.max_penetration, 1e-9);
+  if (!std::isnan(opt.behind_x)) {
+    EXPECT_LE(r.max_behind, 1e-9);
+  }
+}
+
+TEST(StabilityTest, SteelBarImpact) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("steel_bar_impact_2d", opt), opt);
+}
+
+TEST(StabilityTest, WaterWithRealBulkModulus) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("water_real_bulk_2d", opt), opt);
+}
+
+TEST(StabilityTest, NearlyIncompressibleBlock) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("nearly_incompressible_2d", opt), opt);
+}
+
+TEST(StabilityTest, TaylorBarJ2) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("taylor_bar_j2_3d", opt), opt);
+}
+
+TEST(StabilityTest, TaylorBarCopper190) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("taylor_bar_copper_190_3d", opt), opt);
+}
+
+TEST(StabilityTest, DebrisOnWallAt50) {
+  CaseOptions opt;
+  opt.behind_x = 0.75;  // the wall's front face
+  ExpectStable(RunCase("debris_wall_50ms_2d", opt), opt);
+}
+
+TEST(StabilityTest, FineCells) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("fine_cells_2d", opt), opt);
+}
+
+TEST(StabilityTest, CoarseCells) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("coarse_cells_2d", opt), opt);
+}
+
+// Mass leaves through the open sides: no energy balance. Every particle must leave (removed and
+// counted) and the ones still in must stay healthy.
+TEST(StabilityTest, ParticlesFlyingOut) {
+  CaseOptions opt;
+  opt.energy = false;
+  const CaseResult r = RunCase("fly_out_2d", opt);
+  ExpectStable(r, opt);
+  EXPECT_EQ(r.removed, int64_t(r.particles));
+}
+
+TEST(StabilityTest, IsolatedParticlesAndTinyMassNodes) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("isolated_particles_2d", opt), opt);
+}
+
+TEST(StabilityTest, StiffBodyOnSoftSoil) {
+  const CaseOptions opt;
+  ExpectStable(RunCase("stiff_on_soft_2d", opt), opt);
+}
+
+TEST(StabilityTest, ThinObstacleHitAtSpeed) {
+  CaseOptions opt;
+  opt.behind_x = 0.5;  // the plate's front face; the plate is 4 mm (0.2 h) thick
+  ExpectStable(RunCase("thin_obstacle_2d", opt), opt);
+}
+
+// --- Health stops -------------------------------------------------------------------------------
+
+struct StopResult {
+  RunSummary summary;
+  std::string out;
+};
+
+StopResult RunToStop(const std::string& name, const std::vector<std::string>& overrides) {
+  StopResult r;
+  r.out = (std::filesystem::temp_directory_path() /
+           ("surge_stability_" + name + "_" + std::to_string(::getpid())))
+              .string();
+  std::filesystem::remove_all(r.out);
+  LoadedScene scene = LoadScene(StressScene(name), overrides);
+  RunOptions options;
+  options.out_dir = r.out;
+  options.threads = 1;
+  options.progress = ProgressMode::kQuiet;
+  options.force = true;
+  r.summary = RunScene(scene, options);
+  return r;
+}
+
+std::vector<std::string> Files(const std::string& dir) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) out.push_back(e.path().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A fixed dt 2.3 times the CFL limit of steel: the run must stop within a few steps, name the
+// step, the stage and field, the particle, the material and the cause (fixed_dt above the CFL
+// limit, with the limit), write the diagnostic checkpoint of the failed step, keep the failed
+// state out of the results, and refuse to continue from that checkpoint.
+TEST(StabilityTest, FixedDtAboveCflStopsWithDiagnostic) {
+  const StopResult r = RunToStop("steel_bar_impact_2d", {"time.fixed_dt=2e-6"});
+  const std::string& msg = r.summary.exit_status;
+  std::printf("[stability] fixed_dt stop: %s\n", msg.c_str());
+  EXPECT_EQ(r.summary.exit_code, kExitUnhealthy);
+  EXPECT_NE(msg.find("step "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("stage "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("field "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("particle id "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("material 'steel'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Likely cause: time.fixed_dt is above the CFL limit"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("c = 5856 m/s"), std::string::npos) << msg;
+  EXPECT_LT(r.summary.steps, 50);
+  const std::vector<std::string> files = Files(r.out + "/checkpoints");
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_NE(files[0].find("steel_bar_impact_2d_failed_step_"), std::string::npos);
+  const Checkpoint c = ReadCheckpoint(files[0]);
+  EXPECT_EQ(c.state.step, r.summary.steps);
+  // Only the t = 0 snapshot: the failed state is in the checkpoint, not in the results.
+  EXPECT_EQ(r.summary.snapshots, 1);
+  // The diagnostic checkpoint cannot be continued.
+  LoadedScene again = LoadScene(StressScene("steel_bar_impact_2d"), {"time.fixed_dt=2e-6"});
+  RunOptions options;
+  options.out_dir = r.out;
+  options.progress = ProgressMode::kQuiet;
+  options.restart = files[0];
+  EXPECT_THROW(RunScene(again, options), RunRefused);
+  std::filesystem::remove_all(r.out);
+}
+
+// on_exit: stop: the first particle through an open side stops the run with the particle, the
+// stage domain_exit and the remedy named, and a diagnostic checkpoint.
+TEST(StabilityTest, LeavingTheDomainWithOnExitStop) {
+  const StopResult r = RunToStop("fly_out_2d", {"domain.on_exit=stop"});
+  const std::string& msg = r.summary.exit_status;
+  std::printf("[stability] on_exit stop: %s\n", msg.c_str());
+  EXPECT_EQ(r.summary.exit_code, kExitUnhealthy);
+  EXPECT_NE(msg.find("stage domain_exit, field x"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("particle id "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("material 'rubber'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Likely cause"), std::string::npos) << msg;
+  const std::vector<std::string> files = Files(r.out + "/checkpoints");
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_NE(files[0].find("fly_out_2d_failed_step_"), std::string::npos);
+  std::filesystem::remove_all(r.out);
+}
+
+}  // namespace
+}  // namespace surge
