@@ -1,18 +1,19 @@
 // Hencky elasticity and the principal-space return skeleton (Mast 2013 Table 3.4).
 #include "materials/hencky.h"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
+
+#include "materials/symmetric_eigen.h"
 
 namespace surge {
 
 HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_b) {
   const Mat3 b_trial = Sym(f * elastic_b * f.transpose());  // (3.35)
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(b_trial);
   HenckyTrial t;
   t.b = b_trial;
-  t.Q = eig.eigenvectors();
-  t.eps = 0.5 * eig.eigenvalues().array().log();  // (3.34), erratum 2
+  Vec3 b_principal;
+  SymmetricEigen(b_trial, b_principal, t.Q);  // Table 3.4, step 2
+  t.eps = 0.5 * b_principal.array().log();    // (3.34), erratum 2
   t.tau = HenckyStress(K, G, t.eps);
   return t;
 }
@@ -39,8 +40,10 @@ void HenckyFinish(const HenckyTrial& t, Real K, Real G, const Vec3& tau, Real J,
 }
 
 Mat3 ExpTwice(const Mat3& eps) {
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(eps);
-  return FromPrincipal(eig.eigenvectors(), (2.0 * eig.eigenvalues()).array().exp().matrix());
+  Vec3 eps_principal;
+  Mat3 Q;
+  SymmetricEigen(eps, eps_principal, Q);
+  return FromPrincipal(Q, (2.0 * eps_principal).array().exp().matrix());
 }
 
 Mat3 ElasticBFromStress(Real K, Real G, const Mat3& tau) {
