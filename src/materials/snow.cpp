@@ -99,7 +99,14 @@ SnowReturn ReturnToSurface(const SnowParams& m, Real p_tr, Real q_tr, Real alpha
   const Real r_tr = Yield(m, p_tr, q_tr, p0_n);   // > 0: the trial state is outside
   const Real p = d_tr > 0 ? SolveBracketed(R, p_d, p_tr, r_d, r_tr, xtol)
                           : SolveBracketed(R, p_tr, p_d, r_tr, r_d, xtol);
-  return {p, q_of(p), alpha_of(p)};
+  // At the root both q_of(p) and the surface's q, y(p, q; p0(p)) = 0, are exact, but each is
+  // ill-conditioned somewhere: near the top of the ellipse (the critical state, dgamma -> oo)
+  // q_of is 0/0 and amplifies the round-off of p by 1/D(p); near the tips (q -> 0) the surface's
+  // q is the square root of round-off. The smaller of the two is the well-conditioned one in both
+  // places and never lies outside the updated surface.
+  const Real p0 = p0_of(p);
+  const Real q2 = -M2 * (p + beta * p0) * (p - p0) / (1 + 2 * beta);
+  return {p, std::min(q_of(p), std::sqrt(std::max(q2, Real(0)))), alpha_of(p)};
 }
 
 // (p, q) of a stress tensor.

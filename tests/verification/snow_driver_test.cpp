@@ -224,7 +224,7 @@ TEST_P(SnowDriverTest, ShearAtConstantPReachesTheCriticalState) {
     c.stress_controlled = {true, true, true, false, false, false};
     c.target = -pm * Mat3::Identity();
     const Real dt = 2e-4;
-    int wrong_sign = 0, plastic = 0;
+    int wrong_sign = 0, plastic = 0, outside = 0;
     Real peak_ratio = 0;
     for (int step = 0; step < 3000; ++step) {  // shear strain 0.6
       const Real alpha_before = Hist(pt)[kSnowVolumetricPlastic];
@@ -233,6 +233,8 @@ TEST_P(SnowDriverTest, ShearAtConstantPReachesTheCriticalState) {
       const Real d_alpha = Hist(pt)[kSnowVolumetricPlastic] - alpha_before;
       const Real p_cs = 0.5 * (1 - p.cohesion_ratio) * Hist(pt)[kSnowConsolidation];
       peak_ratio = std::max(peak_ratio, ShearStress(tau) / MeanPressure(tau));
+      // Never outside the updated surface, the critical state (top of the ellipse) included.
+      if (SnowYieldFunction(p, tau, Hist(pt)) > 1e-9 * SnowYieldScale(p, tau, Hist(pt))) ++outside;
       if (d_alpha != 0) {
         ++plastic;
         // d eps_v^p = -dgamma M^2 (2p - (1 - beta) p0): compaction above p_cs, dilation below.
@@ -252,6 +254,7 @@ TEST_P(SnowDriverTest, ShearAtConstantPReachesTheCriticalState) {
     EXPECT_NEAR(ratio, ratio_cs, 0.01 * ratio_cs);
     EXPECT_NEAR(MeanPressure(pt.particles.stress[0]), pm, 1e-8 * pm);
     EXPECT_EQ(wrong_sign, 0);
+    EXPECT_EQ(outside, 0);
     EXPECT_GT(plastic, 1000);
     if (factor < 1) {
       EXPECT_GT(d_alpha, 0) << "dense side dilates";
