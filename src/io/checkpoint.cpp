@@ -163,7 +163,13 @@ std::string ReadString(hid_t loc, const char* name, bool dataset, const std::str
   Handle type(dataset ? H5Dget_type(obj.get()) : H5Aget_type(obj.get()), H5Tclose);
   Require(type.ok() && H5Tget_class(type.get()) == H5T_STRING && H5Tis_variable_str(type.get()) <= 0,
           std::string("read ") + name, path);
-  std::string out(H5Tget_size(type.get()), '\0');
+  // One fixed-length string of a sane size: the read writes every element of the dataspace.
+  const size_t size = H5Tget_size(type.get());
+  if (H5ElementCount(obj.get(), dataset) != 1 || size == 0 || size > kH5MaxStringBytes) {
+    throw IoError("checkpoint '" + path + "': " + name + " is not one string of at most " +
+                  std::to_string(kH5MaxStringBytes) + " bytes");
+  }
+  std::string out(size, '\0');
   const herr_t rc = dataset ? H5Dread(obj.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data())
                             : H5Aread(obj.get(), type.get(), out.data());
   Require(rc >= 0, std::string("read ") + name, path);
@@ -175,7 +181,9 @@ template <typename T>
 T ReadScalar(hid_t loc, const char* name, hid_t mem_type, const std::string& path) {
   Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose);
   T value{};
-  Require(attr.ok() && H5Aread(attr.get(), mem_type, &value) >= 0,
+  // Exactly one value: H5Aread writes every element of the attribute into `value`.
+  Require(attr.ok() && H5ElementCount(attr.get(), false) == 1 &&
+              H5Aread(attr.get(), mem_type, &value) >= 0,
           std::string("read attribute ") + name, path);
   return value;
 }
@@ -194,13 +202,18 @@ void ReadArray(hid_t loc, const char* name, hid_t mem_type, size_t rows, size_t 
   Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
   Require(ds.ok(), std::string("open ") + name, path);
   Handle space(H5Dget_space(ds.get()), H5Sclose);
-  hsize_t dims[2] = {0, 0};
+  hsize_t dims[H5S_MAX_RANK] = {};  // the rank is checked after the dims are read
   const int rank = H5Sget_simple_extent_ndims(space.get());
   H5Sget_simple_extent_dims(space.get(), dims, nullptr);
   if (rank != (cols == 0 ? 1 : 2) || dims[0] != rows || (cols != 0 && dims[1] != cols)) {
     throw IoError("checkpoint '" + path + "': " + name + " has the wrong shape (expected " +
                   std::to_string(rows) + " rows" +
                   (cols ? " x " + std::to_string(cols) : std::string()) + ")");
+  }
+  const hsize_t elements = hsize_t(rows) * std::max<size_t>(cols, 1);  // rows < 2^64 / cols
+  if (rows > hsize_t(-1) / 1024 || !H5StorageCovers(ds.get(), elements)) {
+    throw IoError("checkpoint '" + path + "': " + name + " claims " + std::to_string(rows) +
+                  " rows, more than the file stores for it");
   }
   out.resize(rows);
   if (rows > 0) {
@@ -214,7 +227,7 @@ size_t Rows(hid_t loc, const char* name, const std::string& path) {
   Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
   Require(ds.ok(), std::string("open ") + name, path);
   Handle space(H5Dget_space(ds.get()), H5Sclose);
-  hsize_t dims[2] = {0, 0};
+  hsize_t dims[H5S_MAX_RANK] = {};  // any rank fits; ReadArray checks it
   Require(H5Sget_simple_extent_dims(space.get(), dims, nullptr) >= 1, std::string("read ") + name,
           path);
   return size_t(dims[0]);

@@ -1154,6 +1154,9 @@ namespace {
 std::string ReadString(hid_t obj, bool dataset, const std::string& what, const std::string& path) {
   Handle type(dataset ? H5Dget_type(obj) : H5Aget_type(obj), H5Tclose);
   Require(type.ok() && H5Tget_class(type.get()) == H5T_STRING, "read string " + what, path);
+  // Exactly one string: the read writes every element of the dataspace (a list of strings would
+  // overflow `s` or `out`).
+  Require(H5ElementCount(obj, dataset) == 1, "read string " + what + " (not one string)", path);
   if (H5Tis_variable_str(type.get()) > 0) {
     Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(mem.get(), H5T_VARIABLE);
@@ -1167,6 +1170,7 @@ std::string ReadString(hid_t obj, bool dataset, const std::string& what, const s
   }
   // Fixed length: read in the stored type itself (UTF-8 to ASCII has no conversion path).
   const size_t size = H5Tget_size(type.get());
+  Require(size > 0 && size <= kH5MaxStringBytes, "read string " + what + " (corrupt length)", path);
   std::string out(size, '\0');
   const herr_t rc = dataset ? H5Dread(obj, type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data())
                             : H5Aread(obj, type.get(), out.data());
@@ -1205,6 +1209,8 @@ std::vector<double> ReadDoubles(hid_t loc, const std::string& name, size_t cols,
   H5Sget_simple_extent_dims(space.get(), dims, nullptr);
   if (cols != 0 && dims[1] != cols)
     throw IoError("'" + path + "': " + name + " has " + std::to_string(dims[1]) + " columns, expected " + std::to_string(cols));
+  if (dims[0] > hsize_t(-1) / 1024 || !H5StorageCovers(ds.get(), dims[0] * std::max<size_t>(cols, 1)))
+    throw IoError("'" + path + "': " + name + " claims " + std::to_string(dims[0]) + " rows, more than the file stores for it");
   rows = size_t(dims[0]);
   std::vector<double> out(rows * std::max<size_t>(cols, 1));
   if (!out.empty()) {
@@ -1263,7 +1269,9 @@ StoredResult ReadResultForces(const std::string& h5_path) {
   if (H5Aexists(file.get(), "dimension") > 0) {
     Handle attr(H5Aopen(file.get(), "dimension", H5P_DEFAULT), H5Aclose);
     int dim = 3;
-    if (attr.ok() && H5Aread(attr.get(), H5T_NATIVE_INT, &dim) >= 0) r.dimension = dim;
+    if (attr.ok() && H5ElementCount(attr.get(), false) == 1 &&
+        H5Aread(attr.get(), H5T_NATIVE_INT, &dim) >= 0)
+      r.dimension = dim;
   }
   if (H5Lexists(file.get(), "timing", H5P_DEFAULT) > 0) {
     Handle g(H5Gopen2(file.get(), "timing", H5P_DEFAULT), H5Gclose);

@@ -4,6 +4,8 @@
 #include <hdf5.h>
 
 #include <filesystem>
+
+#include "io/h5_handle.h"
 #include <vector>
 
 namespace surge {
@@ -24,6 +26,8 @@ bool ReadStringAttr(hid_t obj, const char* name, std::string& out) {
   if (attr.id < 0) return false;
   Id type{H5Aget_type(attr.id), H5Tclose};
   if (type.id < 0 || H5Tget_class(type.id) != H5T_STRING) return false;
+  // Exactly one string (the read writes every element) of a sane length.
+  if (H5ElementCount(attr.id, false) != 1) return false;
   if (H5Tis_variable_str(type.id) > 0) {
     char* s = nullptr;
     Id mem{H5Tcopy(H5T_C_S1), H5Tclose};
@@ -35,6 +39,7 @@ bool ReadStringAttr(hid_t obj, const char* name, std::string& out) {
   }
   // Fixed length, null padded (the writer's StringType).
   const size_t size = H5Tget_size(type.id);
+  if (size == 0 || size > kH5MaxStringBytes) return false;
   std::vector<char> buf(size + 1, '\0');
   if (H5Aread(attr.id, type.id, buf.data()) < 0) return false;
   out.assign(buf.data());
@@ -45,7 +50,8 @@ template <typename T>
 bool ReadScalarAttr(hid_t obj, const char* name, hid_t mem_type, T& out) {
   if (H5Aexists(obj, name) <= 0) return false;
   Id attr{H5Aopen(obj, name, H5P_DEFAULT), H5Aclose};
-  return attr.id >= 0 && H5Aread(attr.id, mem_type, &out) >= 0;
+  return attr.id >= 0 && H5ElementCount(attr.id, false) == 1 &&
+         H5Aread(attr.id, mem_type, &out) >= 0;
 }
 
 }  // namespace

@@ -216,6 +216,74 @@ TEST_F(CheckpointTest, ForeignFilesAreRefusedNamingThePath) {
   expect_error((dir_ / "result.h5").string(), "not a Surge checkpoint");
 }
 
+// Replaces attribute `name` of `loc` in `file` by an int64 array of `n` elements (a scalar read
+// of it wrote n values into one).
+void ReplaceWithArrayAttr(const std::string& file, const char* loc, const char* name, hsize_t n) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t o = H5Oopen(f, loc, H5P_DEFAULT);
+  H5Adelete(o, name);
+  const hid_t space = H5Screate_simple(1, &n, nullptr);
+  const hid_t a = H5Acreate2(o, name, H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT);
+  const std::vector<int64_t> v(n, 1);
+  H5Awrite(a, H5T_NATIVE_INT64, v.data());
+  H5Aclose(a);
+  H5Sclose(space);
+  H5Oclose(o);
+  H5Fclose(f);
+}
+
+// Shapes the reader used to trust (an attribute read as a scalar, a dataset's rank): a crafted or
+// corrupt file gave a stack or heap overflow; now an IoError naming the file (fuzz_io checks).
+TEST_F(CheckpointTest, MalformedShapesAreRefusedNamingThePath) {
+  const Checkpoint c = FullCheckpoint(4);
+  const auto expect_error = [](const std::string& path) {
+    try {
+      ReadCheckpoint(path);
+      ADD_FAILURE() << "no IoError for " << path;
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  const std::string step = (dir_ / "step.h5").string();
+  WriteCheckpoint(step, c);
+  ReplaceWithArrayAttr(step, "/", "step", 64);
+  expect_error(step);
+  const std::string name = (dir_ / "name.h5").string();  // a list of strings, not one
+  WriteCheckpoint(name, c);
+  {
+    const hid_t f = H5Fopen(name.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    H5Adelete(f, "name");
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, 4);
+    const hsize_t n = 16;
+    const hid_t space = H5Screate_simple(1, &n, nullptr);
+    const hid_t a = H5Acreate2(f, "name", type, space, H5P_DEFAULT, H5P_DEFAULT);
+    const std::string text(64, 'x');
+    H5Awrite(a, type, text.data());
+    H5Aclose(a);
+    H5Sclose(space);
+    H5Tclose(type);
+    H5Fclose(f);
+  }
+  expect_error(name);
+  const std::string rank = (dir_ / "rank.h5").string();  // particles/x of rank 4
+  WriteCheckpoint(rank, c);
+  {
+    const hid_t f = H5Fopen(rank.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    H5Ldelete(f, "particles/x", H5P_DEFAULT);
+    const hsize_t dims[4] = {4, 3, 2, 2};
+    const hid_t space = H5Screate_simple(4, dims, nullptr);
+    const hid_t d = H5Dcreate2(f, "particles/x", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
+                               H5P_DEFAULT);
+    const std::vector<double> v(48, 0.5);
+    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+    H5Dclose(d);
+    H5Sclose(space);
+    H5Fclose(f);
+  }
+  expect_error(rank);
+}
+
 TEST_F(CheckpointTest, ListedOldestFirst) {
   const Checkpoint c = FullCheckpoint(1);
   for (int64_t step : {1000, 20, 300}) WriteCheckpoint(CheckpointPath(dir_.string(), "dam", step), c);
