@@ -18,14 +18,21 @@ struct EnergyRecord {
   Real wall_work = 0;      // cumulative work of the domain walls on the particles
 };
 
-enum class HealthStatus { kOk, kNonFinite, kInvertedElement, kLeftDomain, kTimeStepTooSmall };
+enum class HealthStatus {
+  kOk,
+  kNonFinite,
+  kInvertedElement,
+  kLeftDomain,
+  kTimeStepTooSmall,
+  kEnergyGrowth  // energy guard: mechanical energy doubled without external work (EnergyStage)
+};
 
 struct Health {
   HealthStatus status = HealthStatus::kOk;
   int64_t particle_id = -1;  // first offender (seeding id)
   std::string detail;        // field and value, the particle, the likely cause: the diagnostic
   std::string stage;         // the stage that produced the bad value (StageName), or "time_step"
-  std::string field;         // "v", "x", "F", "J", "stress", "dt"
+  std::string field;         // "v", "x", "F", "J", "stress", "dt", "E"
 };
 
 }  // namespace surge

@@ -243,6 +243,8 @@ namespace {
 // update_stress. Every field was finite and J > 0 at the end of the previous step (the check runs
 // every step), so the earliest bad field in this order names the stage that produced it.
 enum BadField : int { kFieldOk = 0, kFieldV, kFieldX, kFieldF, kFieldJ, kFieldStress, kFieldCount };
+// Not a particle field: the energy guard of EnergyStage.
+constexpr int kFieldEnergy = kFieldCount;
 
 std::string Num(double v) {
   char buf[32];
@@ -259,8 +261,9 @@ std::string Point(const Vec3& x, int dim) {
 // The diagnostic of a failed health check (failure path only): the field and stage, the particle
 // with its material and body, and the likely cause from the time step against the CFL limit
 // dt <= C h / (c + |v|) (spec §1.7) of the stiffest material present.
+// `what`: the energy guard's own description (field kFieldEnergy).
 void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, size_t p, int field,
-                       size_t count, Health& h) {
+                       size_t count, Health& h, const std::string& what = "") {
   const Particles& P = s.particles;
   const Material& mat = m.materials[size_t(P.material[p])];
   const std::string body =
@@ -304,6 +307,11 @@ void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, s
       if (antilocked) h.stage += " or anti_locking";
       h.detail = "inverted particle, det F = J = " + Num(J) + " <= 0 (|v| = " + Num(speed) + " m/s)";
       break;
+    case kFieldEnergy:
+      h.field = "E";
+      h.stage = "energy";
+      h.detail = what + "; the fastest particle is";
+      break;
     default:
       h.field = "stress";
       h.stage = "update_stress";
@@ -311,11 +319,13 @@ void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, s
                  " m/s): the constitutive update failed";
       break;
   }
-  h.detail += " at particle id " + std::to_string(P.id[p]) + " (material '" + mat.name +
-              "', body '" + body + "', x = " +
-              (P.x[p].allFinite() ? Point(P.x[p], m.dim) : std::string("non-finite")) +
-              "), produced by stage " + h.stage + "; " + std::to_string(count) + " of " +
-              std::to_string(P.size()) + " particles unhealthy. ";
+  h.detail += (field == kFieldEnergy ? " particle id " : " at particle id ") +
+              std::to_string(P.id[p]) + " (material '" + mat.name + "', body '" + body +
+              "', x = " + (P.x[p].allFinite() ? Point(P.x[p], m.dim) : std::string("non-finite")) +
+              (field == kFieldEnergy ? ", |v| = " + Num(speed) + " m/s), found by stage energy. "
+                                     : "), produced by stage " + h.stage + "; " +
+                                           std::to_string(count) + " of " +
+                                           std::to_string(P.size()) + " particles unhealthy. ");
 
   // Likely cause.
   const std::string cfl_text = "dt = " + Num(ctx.dt) + " s against the CFL limit h/c = " +
@@ -340,6 +350,11 @@ void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, s
             "than the grid resolves, or a node with tiny mass (an isolated particle at a cell "
             "edge). Add bulk_viscosity to material '" + mat.name + "' for shocks, or lower "
             "time.cfl (e.g. to 0.2).";
+  } else if (field == kFieldEnergy) {
+    cause = "an instability below the wave-speed limit (" + cfl_text + " is within it): the "
+            "stable Courant number of this setup is lower than time.cfl (nearly incompressible "
+            "material, isolated particles, stiff contact; docs/stability.md). Lower time.cfl "
+            "(e.g. to 0.2).";
   } else {
     cause = "an instability that the CFL rule does not cover (" + cfl_text +
             " is within the limit): a node with tiny mass (isolated particles), a contact or "
@@ -414,8 +429,66 @@ EnergyRecord ComputeEnergy(const Model& m, const State& s) {
   return e;
 }
 
-void EnergyStage(const Model& m, const StepContext&, State& s, Workspace&, StepReport& r) {
+// Energy record, and the energy guard (docs/stability.md): where nothing can do work on the
+// particles (fixed walls and obstacles, no tractions, no gravity ramp), the mechanical energy
+// E = kinetic + strain + gravitational, measured from the domain's lowest corner so that it is
+// never negative, cannot grow; a step that leaves it above kEnergyGuardFactor x its value at the
+// first step is a numerical blow-up that has not (yet) produced a NaN or an inverted particle,
+// and stops the run. Cost: a comparison per step (the energy is computed anyway), plus a pass over
+// the masses on steps where particles left.
+void EnergyStage(const Model& m, const StepContext& ctx, State& s, Workspace& w, StepReport& r) {
   r.energy = ComputeEnergy(m, s);
+  if (r.health.status != HealthStatus::kOk) return;
+  constexpr Real kEnergyGuardFactor = 2;
+  Workspace::EnergyGuard& g = w.energy_guard;
+  const Particles& P = s.particles;
+  auto mass = [&] {
+    Real sum = 0;
+    for (Real mp : P.mass) sum += mp;
+    return sum;
+  };
+  if (!g.set) {
+    g.set = true;
+    const bool moving = std::any_of(m.obstacles.begin(), m.obstacles.end(), [](const Obstacle& o) {
+      return o.motion.kind != ObstacleMotionKind::kFixed;
+    });
+    const bool tractions = std::any_of(P.ext_force.begin(), P.ext_force.end(),
+                                       [](const Vec3& f) { return !f.isZero(0); });
+    g.floor = std::numeric_limits<Real>::infinity();
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner((c & 1) ? m.domain_max.x() : m.domain_min.x(),
+                        (c & 2) ? m.domain_max.y() : m.domain_min.y(),
+                        m.dim == 3 ? ((c & 4) ? m.domain_max.z() : m.domain_min.z()) : 0.0);
+      g.floor = std::min(g.floor, -m.gravity.dot(corner));  // potential per kg, -g.x
+    }
+    g.floor_energy = g.floor * mass();
+    g.reference = r.energy.kinetic + r.energy.strain + r.energy.gravitational - g.floor_energy;
+    g.active = !moving && !tractions && m.gravity_ramp <= 0 && g.reference > 0;
+    return;
+  }
+  if (!g.active) return;
+  if (r.removed_last_step > 0) g.floor_energy = g.floor * mass();
+  const Real e = r.energy.kinetic + r.energy.strain + r.energy.gravitational - g.floor_energy;
+  if (!(e > kEnergyGuardFactor * g.reference)) return;
+  size_t fastest = 0;
+  for (size_t p = 1; p < P.size(); ++p)
+    if (P.v[p].squaredNorm() > P.v[fastest].squaredNorm()) fastest = p;
+  Health h;
+  h.status = HealthStatus::kEnergyGrowth;
+  h.particle_id = P.size() > 0 ? P.id[fastest] : -1;
+  const std::string what =
+      "mechanical energy (kinetic + strain + gravity above the domain floor) grew from " +
+      Num(g.reference) + " J to " + Num(e) + " J (x" + Num(e / g.reference) +
+      ") although nothing does work on the particles (fixed walls and obstacles, no tractions, "
+      "no gravity ramp): a numerical blow-up";
+  if (P.size() > 0) {
+    DescribeUnhealthy(m, ctx, s, fastest, kFieldEnergy, 0, h, what);
+  } else {
+    h.field = "E";
+    h.stage = "energy";
+    h.detail = what;
+  }
+  r.health = std::move(h);
 }
 
 }  // namespace surge

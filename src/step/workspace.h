@@ -23,6 +23,14 @@ struct Workspace {
   BulkViscosityScratch bulk_viscosity;  // q_p between steps: its q, id and dt_bound are saved
                                         // in checkpoints (io/checkpoint.h)
   ContactScratch contact;               // broad phase and partial sums of the obstacle contact
+  // Energy guard of EnergyStage (docs/stability.md): set on its first step of a run or restart.
+  struct EnergyGuard {
+    bool set = false;
+    bool active = false;   // false where external work can add energy (see EnergyStage)
+    Real reference = 0;    // mechanical energy above the domain floor at the first step [J]
+    Real floor = 0;        // potential per kg at the domain's lowest corner [J/kg]
+    Real floor_energy = 0; // floor x the particle mass now [J]
+  } energy_guard;
   // Bullet world of the dynamic obstacles (built from Model + State on first use; the rigid
   // state of record is State::rigid), each dynamic body's handle and its Bullet frame at t = 0.
   std::unique_ptr<RigidWorld> rigid_world;

@@ -6,7 +6,8 @@
 // corner) in the scenes where nothing does external work (fixed walls and obstacles only, no
 // particles leaving). Cases made to fail must stop with exit code 3, a message naming the step,
 // stage, field, particle, material and likely cause, a diagnostic checkpoint, and results that
-// hold no snapshot of the failed state.
+// hold no snapshot of the failed state; a silent blow-up (energy growth without NaN) must be
+// stopped by the energy guard.
 //
 // Each case prints one line (the table of docs/stability.md): particles, steps, dt against the
 // CFL limit h / max(c + |v|) (spec §1.7) taken from the state at the start of each step, the
@@ -283,6 +284,27 @@ TEST(StabilityTest, FixedDtAboveCflStopsWithDiagnostic) {
   options.progress = ProgressMode::kQuiet;
   options.restart = files[0];
   EXPECT_THROW(RunScene(again, options), RunRefused);
+  std::filesystem::remove_all(r.out);
+}
+
+// The nu = 0.4999 block at time.cfl = 0.8 (twice the default) blows up without a NaN or an
+// inverted particle for thousands of steps (measured without the guard: energy x430, exit code 0):
+// the energy guard must stop it, naming the stage, the fastest particle and the cause.
+TEST(StabilityTest, SilentBlowUpStoppedByEnergyGuard) {
+  const StopResult r = RunToStop("nearly_incompressible_2d", {"time.cfl=0.8"});
+  const std::string& msg = r.summary.exit_status;
+  std::printf("[stability] energy guard stop: %s\n", msg.c_str());
+  EXPECT_EQ(r.summary.exit_code, kExitUnhealthy);
+  EXPECT_NE(msg.find("stage energy, field E"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("particle id "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("material 'rubber'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Likely cause: an instability below the wave-speed limit"), std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("Lower time.cfl"), std::string::npos) << msg;
+  EXPECT_LT(r.summary.steps, 1000);
+  const std::vector<std::string> files = Files(r.out + "/checkpoints");
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_NE(files[0].find("nearly_incompressible_2d_failed_step_"), std::string::npos);
   std::filesystem::remove_all(r.out);
 }
 
