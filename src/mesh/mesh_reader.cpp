@@ -100,9 +100,32 @@ TriangleMesh ReadTriangleMesh(const std::string& path) {
   Assimp::Importer importer;
   // No aiProcess_PreTransformVertices: it joins meshes that share a material, which would merge
   // the parts. The node transforms are applied in Builder::AddNode instead.
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                         aiProcess_SortByPType;
-  const aiScene* scene = importer.ReadFile(path, flags);
+  // Import with validation only (indices out of range), reject faces without vertices, repair
+  // the primitive-type flags, and only then post-process: a broken PLY gave a face with no
+  // indices and a POLYGON flag without polygons, and Debian's assimp, built with assertions,
+  // aborted the whole process in Triangulate on that (fuzz_mesh finding). The post-processing
+  // steps and their order are the same as ReadFile(path, flags) would apply.
+  const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw std::runtime_error("cannot read mesh file '" + path + "': " + importer.GetErrorString());
+  }
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    aiMesh* am = scene->mMeshes[m];
+    unsigned types = 0;
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const unsigned n = am->mFaces[f].mNumIndices;
+      if (n == 0 || am->mFaces[f].mIndices == nullptr) {
+        throw std::runtime_error("mesh file '" + path + "': face " + std::to_string(f + 1) +
+                                 " of mesh '" + am->mName.C_Str() + "' has no vertices");
+      }
+      types |= n == 1 ? aiPrimitiveType_POINT
+                      : n == 2 ? aiPrimitiveType_LINE
+                               : n == 3 ? aiPrimitiveType_TRIANGLE : aiPrimitiveType_POLYGON;
+    }
+    am->mPrimitiveTypes = types;
+  }
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                       aiProcess_SortByPType);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw std::runtime_error("cannot read mesh file '" + path + "': " + importer.GetErrorString());
   }

@@ -102,6 +102,16 @@ TEST(ReadTriangleMeshTest, NonFiniteVertexThrowsNamingIt) {
                  "is not finite");
 }
 
+// Found by fuzz_mesh (corpus/mesh/regress_ply_triangulate_assert.ply): a PLY face line with no
+// indices made assimp's Triangulate step fail an assertion, which aborted the process.
+TEST(ReadTriangleMeshTest, FaceWithoutVerticesThrowsNamingIt) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0\n";
+  ExpectRejected(WriteTemp("empty_face.ply", ply), "has no vertices");
+}
+
 // A named pipe blocked the reader forever (a scene's mesh path is user input).
 TEST(ReadTriangleMeshTest, NamedPipeIsNotARegularFile) {
   const std::string path = ::testing::TempDir() + "mesh_fifo_" + std::to_string(getpid()) + ".stl";
