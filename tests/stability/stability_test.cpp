@@ -287,6 +287,20 @@ TEST(StabilityTest, FixedDtAboveCflStopsWithDiagnostic) {
   std::filesystem::remove_all(r.out);
 }
 
+// Without the energy series (output.energy: false) there is no energy guard: the same run stops
+// two steps later at the health check, at an inverted particle made by grid_to_particle.
+TEST(StabilityTest, FixedDtAboveCflWithoutEnergyStopsAtInvertedParticle) {
+  const StopResult r = RunToStop("steel_bar_impact_2d", {"time.fixed_dt=2e-6", "output.energy=false"});
+  const std::string& msg = r.summary.exit_status;
+  std::printf("[stability] fixed_dt stop without energy: %s\n", msg.c_str());
+  EXPECT_EQ(r.summary.exit_code, kExitUnhealthy);
+  EXPECT_NE(msg.find("stage grid_to_particle, field J: inverted particle"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("material 'steel', body 'bar'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Likely cause: time.fixed_dt is above the CFL limit"), std::string::npos) << msg;
+  EXPECT_EQ(Files(r.out + "/checkpoints").size(), 1u);
+  std::filesystem::remove_all(r.out);
+}
+
 // The nu = 0.4999 block at time.cfl = 0.8 (twice the default) blows up without a NaN or an
 // inverted particle for thousands of steps (measured without the guard: energy x430, exit code 0):
 // the energy guard must stop it, naming the stage, the fastest particle and the cause.
