@@ -5,8 +5,10 @@
 
 #include <array>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -15,6 +17,10 @@
 
 namespace surge {
 namespace {
+
+// How far into a PLY file its "end_header" line must appear [bytes]: a header lists a few element
+// and property lines (comments included, kilobytes at most).
+constexpr size_t kPlyHeaderBytes = 65536;
 
 struct Builder {
   std::string path;  // for error messages
@@ -96,6 +102,21 @@ TriangleMesh ReadTriangleMesh(const std::string& path) {
     const bool exists = std::filesystem::exists(path, ec);
     throw std::runtime_error("cannot read mesh file '" + path + "': " +
                              (exists ? "not a regular file" : "no such file"));
+  }
+  // assimp 5.2's PLY reader loops forever on a header without "end_header" (fuzz_mesh finding):
+  // look for it first in anything named .ply or starting with the "ply" magic.
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string head(kPlyHeaderBytes, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(size_t(in.gcount()));
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if ((ext == ".ply" || head.rfind("ply", 0) == 0) && head.find("end_header") == std::string::npos) {
+      throw std::runtime_error("cannot read mesh file '" + path +
+                               "': PLY header without an end_header line in its first " +
+                               std::to_string(kPlyHeaderBytes) + " bytes");
+    }
   }
   Assimp::Importer importer;
   // No aiProcess_PreTransformVertices: it joins meshes that share a material, which would merge

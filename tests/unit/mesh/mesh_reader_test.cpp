@@ -112,6 +112,13 @@ TEST(ReadTriangleMeshTest, FaceWithoutVerticesThrowsNamingIt) {
   ExpectRejected(WriteTemp("empty_face.ply", ply), "has no vertices");
 }
 
+// Found by fuzz_mesh (corpus/mesh/regress_ply_no_end_header): assimp's PLY reader looped
+// forever on a header without end_header.
+TEST(ReadTriangleMeshTest, PlyWithoutEndHeaderThrowsNamingIt) {
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n0\n";
+  ExpectRejected(WriteTemp("no_end_header.ply", ply), "without an end_header line");
+}
+
 // A named pipe blocked the reader forever (a scene's mesh path is user input).
 TEST(ReadTriangleMeshTest, NamedPipeIsNotARegularFile) {
   const std::string path = ::testing::TempDir() + "mesh_fifo_" + std::to_string(getpid()) + ".stl";
