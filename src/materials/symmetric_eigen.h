@@ -11,8 +11,9 @@ namespace surge {
 // One eigenvalue from the characteristic cubic, an exact rotation for the other two: the extreme
 // eigenvalue farthest from the other two is a root of the cubic (Smith 1961, Commun. ACM 4(4):168)
 // found by a monotone Newton iteration, accurate also near a double root; its eigenvector is the
-// largest cross product of two rows of A - lambda I; the remaining pair diagonalises the 2x2 projection of A onto that vector's complement by one
-// Jacobi rotation (Golub & Van Loan 2013, Alg. 8.5.1), which is exact for any gap, zero included.
+// largest cross product of two rows of A - lambda I; the remaining pair diagonalises the 2x2
+// projection of A onto that vector's complement by one Jacobi rotation (Golub & Van Loan 2013,
+// Alg. 8.5.1), which is exact for any gap, zero included.
 // Residual |A Q - Q diag| <= ~6e-16 |A| and |Q^T Q - I| <= ~2e-15 on random, double, near-double
 // and triple roots (tests/unit/materials/symmetric_eigen_test.cpp); about 2.4x faster than
 // Eigen::SelfAdjointEigenSolver's iterative QR on this machine (docs/benchmarks.md).
