@@ -10,8 +10,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mesh/mesh.h"
 
@@ -92,6 +95,60 @@ struct Builder {
   }
 };
 
+// Throws naming the file and line unless `head` (the first kPlyHeaderBytes of the file) starts
+// with a well-formed PLY header (Bourke's PLY format): "ply", one "format <ascii|binary_*> 1.0",
+// then only "comment"/"obj_info" lines, "element <name> <count>" and "property <type> <name>" or
+// "property list <type> <type> <name>" lines, up to "end_header".
+void CheckPlyHeader(const std::string& path, const std::string& head) {
+  static const std::set<std::string> kTypes = {
+      "char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8",
+      "int16", "uint16", "int32", "uint32", "float32", "float64"};
+  const auto fail = [&](int line, const std::string& what) {
+    throw std::runtime_error("cannot read mesh file '" + path + "': line " + std::to_string(line) +
+                             ": " + what);
+  };
+  std::istringstream lines(head);
+  std::string text;
+  int line = 0;
+  bool format = false;
+  while (std::getline(lines, text)) {
+    ++line;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    std::istringstream words(text);
+    std::vector<std::string> w;
+    for (std::string word; words >> word;) w.push_back(word);
+    if (line == 1) {
+      if (w.size() != 1 || w[0] != "ply") fail(line, "a PLY file starts with a line \"ply\"");
+      continue;
+    }
+    if (w.empty()) fail(line, "empty line in the PLY header");
+    if (w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "end_header") {
+      if (!format) fail(line, "PLY header without a format line");
+      return;
+    }
+    if (w[0] == "format") {
+      if (format || w.size() != 3 || w[2] != "1.0" ||
+          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
+        fail(line, "expected one \"format ascii|binary_little_endian|binary_big_endian 1.0\"");
+      format = true;
+    } else if (w[0] == "element") {
+      if (w.size() != 3 || w[2].find_first_not_of("0123456789") != std::string::npos ||
+          w[2].size() > 10)
+        fail(line, "expected \"element <name> <count>\"");
+    } else if (w[0] == "property") {
+      const bool list = w.size() == 5 && w[1] == "list" && kTypes.count(w[2]) && kTypes.count(w[3]);
+      const bool scalar = w.size() == 3 && kTypes.count(w[1]);
+      if (!list && !scalar)
+        fail(line, "expected \"property <type> <name>\" or \"property list <type> <type> <name>\"");
+    } else {
+      fail(line, "unknown PLY header line \"" + w[0].substr(0, 40) + "\"");
+    }
+  }
+  fail(line, "PLY header without an end_header line in its first " +
+                 std::to_string(kPlyHeaderBytes) + " bytes");
+}
+
 }  // namespace
 
 TriangleMesh ReadTriangleMesh(const std::string& path) {
@@ -103,8 +160,8 @@ TriangleMesh ReadTriangleMesh(const std::string& path) {
     throw std::runtime_error("cannot read mesh file '" + path + "': " +
                              (exists ? "not a regular file" : "no such file"));
   }
-  // assimp 5.2's PLY reader loops forever on a header without "end_header" (fuzz_mesh finding):
-  // look for it first in anything named .ply or starting with the "ply" magic.
+  // assimp 5.2's PLY reader loops forever on a header without "end_header" or with a malformed
+  // line (fuzz_mesh hangs): check the header of anything named .ply or starting with "ply".
   {
     std::ifstream in(path, std::ios::binary);
     std::string head(kPlyHeaderBytes, '\0');
@@ -112,11 +169,7 @@ TriangleMesh ReadTriangleMesh(const std::string& path) {
     head.resize(size_t(in.gcount()));
     std::string ext = std::filesystem::path(path).extension().string();
     for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if ((ext == ".ply" || head.rfind("ply", 0) == 0) && head.find("end_header") == std::string::npos) {
-      throw std::runtime_error("cannot read mesh file '" + path +
-                               "': PLY header without an end_header line in its first " +
-                               std::to_string(kPlyHeaderBytes) + " bytes");
-    }
+    if (ext == ".ply" || head.rfind("ply", 0) == 0) CheckPlyHeader(path, head);
   }
   Assimp::Importer importer;
   // No aiProcess_PreTransformVertices: it joins meshes that share a material, which would merge

@@ -115,8 +115,13 @@ TEST(ReadTriangleMeshTest, FaceWithoutVerticesThrowsNamingIt) {
 // Found by fuzz_mesh (corpus/mesh/regress_ply_no_end_header): assimp's PLY reader looped
 // forever on a header without end_header.
 TEST(ReadTriangleMeshTest, PlyWithoutEndHeaderThrowsNamingIt) {
-  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n0\n";
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n";
   ExpectRejected(WriteTemp("no_end_header.ply", ply), "without an end_header line");
+  // ... and on a header line it does not know (corpus/mesh/regress_ply_bad_header_line).
+  const std::string bad =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nprmperty float y\n"
+      "end_header\n0 0\n";
+  ExpectRejected(WriteTemp("bad_header_line.ply", bad), "line 5: unknown PLY header line");
 }
 
 // A named pipe blocked the reader forever (a scene's mesh path is user input).
