@@ -44,6 +44,8 @@ enum class AntiLockingStrain { kTotal, kIncrement };
 struct AntiLocking {
   AntiLockingMethod method = AntiLockingMethod::kNone;
   AntiLockingStrain strain = AntiLockingStrain::kTotal;
+  // Also project the mean stress after the stress update (seed Table 4.1 steps 6-7, optional).
+  bool stress = false;
 };
 
 // Cundall's local non-viscous damping of the grid momentum balance (Anura3D manual §6.3.1, eqs.

@@ -537,13 +537,19 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
     m.values[d.key] = static_cast<Real>(it - choices.begin());
   }
   if (const YAML::Node al = n["antilocking"]) {
-    // antilocking: {method: none | node | cell, approach: volumetric, strain: total | increment}
-    // (docs/antilocking.md).
+    // antilocking: {method: none | node | cell, approach: volumetric, strain: total | increment,
+    // stress: false | true} (docs/antilocking.md).
     const std::string ap = Child(path, "antilocking");
-    ExpectMap(al, ap, {"method", "approach", "strain"});
+    ExpectMap(al, ap, {"method", "approach", "strain", "stress"});
     m.antilocking = Enum(Need(al, ap, "method"), Child(ap, "method"), kAntiLockingNames);
     if (al["strain"]) {
       m.antilocking_strain = Enum(al["strain"], Child(ap, "strain"), kAntiLockingStrainNames);
+    }
+    if (const YAML::Node st = al["stress"]) {
+      m.antilocking_stress = Bool(st, Child(ap, "stress"));
+      if (m.antilocking_stress && *m.antilocking == AntiLockingMethod::kNone) {
+        Fail(st, Child(ap, "stress"), "stress averaging needs a control volume: method node or cell");
+      }
     }
     if (const YAML::Node a = al["approach"]) {
       if (!a.IsScalar() || a.Scalar() != "volumetric") {
@@ -1434,6 +1440,7 @@ SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
 AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
   AntiLocking a;
   a.strain = m.antilocking_strain;
+  a.stress = m.antilocking_stress;
   if (m.antilocking) {
     a.method = *m.antilocking;
   } else {
@@ -1604,7 +1611,9 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     e << YAML::Key << "antilocking" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
       << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
       << "approach" << YAML::Value << "volumetric" << YAML::Key << "strain" << YAML::Value
-      << NameOf(kAntiLockingStrainNames, al.strain) << YAML::EndMap;
+      << NameOf(kAntiLockingStrainNames, al.strain);
+    if (al.stress) e << YAML::Key << "stress" << YAML::Value << true;  // only when on
+    e << YAML::EndMap;
     if (m.bulk_viscosity.enabled) {  // only when on (resolved scenes without it stay the same)
       e << YAML::Key << "bulk_viscosity" << YAML::Value << YAML::Flow << YAML::BeginMap
         << YAML::Key << "quadratic" << YAML::Value << Num(m.bulk_viscosity.quadratic)

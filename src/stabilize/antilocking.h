@@ -42,4 +42,20 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
 // True when any material of the model is anti-locked (the pipeline then has the stage).
 bool AnyAntiLocking(const Model& model);
 
+// The optional stress approximation of Table 4.1 (steps 6-7) for the anti-locked groups that ask
+// for it (`antilocking: {stress: true}`), on the same control volumes as the strain: the specific
+// mean stress q_p = tr(tau_p) / (3 rho0_p) is projected as theta is (mass weights, (4.25)_2-(4.28),
+// (4.29)_2-(4.32)_2), and each particle's Cauchy stress takes the projected mean,
+// sigma_p += (rho0_p q-bar_p / J_p - tr(sigma_p)/3) 1; the deviator is kept (P = I_dev). The seed
+// found the strain approximation alone sufficient and this step to double the cost (Diss. §7.5,
+// footnote 11). Reads F, mass, volume0, x_n; writes stress of those groups and scratch.
+// Pre: the stress update of this step has run; grid and binning from x_n.
+void ProjectMeanStress(const Model& model, const StepContext& ctx,
+                       const std::vector<MaterialGroup>& groups, Particles& particles,
+                       const std::vector<Vec3>& x_n, const SparseGrid& grid,
+                       AntiLockingScratch& scratch);
+
+// True when any anti-locked material also averages its stress (the pipeline then has the stage).
+bool AnyStressAveraging(const Model& model);
+
 }  // namespace surge

@@ -87,6 +87,13 @@ void AntiLockingStage(const Model& m, const StepContext& c, State& s, Workspace&
                           w.velocity_gradient);
 }
 
+// Runs right after UpdateStress; x_new holds x_n there (the USL keep stage and MUSL's velocity
+// gradient stage swapped it), the positions the grid was binned with.
+void StressAveragingStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                          StepReport&) {
+  ProjectMeanStress(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking);
+}
+
 void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                        StepReport&) {
   UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles);

@@ -34,6 +34,7 @@ void VelocityGradientStage(const Model&, const StepContext&, State&, Workspace&,
 void GridToParticleUslKeepStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Volumetric anti-locking of L_p (src/stabilize) with the shape functions at x_n = Workspace::x_new.
 void AntiLockingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void StressAveragingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void UpdateStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Artificial bulk viscosity (src/stabilize/bulk_viscosity.h): q_p from this step's L_p (after
 // UpdateStress), sigma - q 1 for ParticleToGrid (before it) and the material stress back (after).

@@ -58,6 +58,8 @@ Pipeline MakePipeline(const Model& model) {
   if (!model.sensors.empty()) p.push_back({Stage::kSensors, SensorsStage});  // all reactions in
   if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
   p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)
+  if (AnyStressAveraging(model))  // Table 4.1 steps 6-7, timed with the strain projection
+    p.push_back({Stage::kAntiLocking, StressAveragingStage});
   if (bulk_viscosity) p.push_back({Stage::kBulkViscosity, BulkViscosityRateStage});  // q_p
   p.push_back({Stage::kDomainExit, DomainExitStage});
   p.push_back({Stage::kCheckState, CheckStateStage});

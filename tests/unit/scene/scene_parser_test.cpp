@@ -768,7 +768,17 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   ExpectError(WithMaterial(steel + "antilocking: {method: cell, strain: trial}}"), 7,
               "materials.steel.antilocking.strain", "expected one of: total, increment");
   ExpectError(WithMaterial(steel + "antilocking: node}"), 7, "materials.steel.antilocking",
-              "expected a map with keys method, approach, strain");
+              "expected a map with keys method, approach, strain, stress");
+  ExpectError(WithMaterial(steel + "antilocking: {method: none, stress: true}}"), 7,
+              "materials.steel.antilocking.stress", "needs a control volume");
+  ExpectError(WithMaterial(steel + "antilocking: {method: cell, stress: 2}}"), 7,
+              "materials.steel.antilocking.stress", "");
+  {  // stress averaging: parsed, and written back to the resolved YAML only when on
+    const LoadedScene avg = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: node, stress: true}}"), "ok.yaml");
+    EXPECT_TRUE(avg.model.antilocking[0].stress);
+    EXPECT_TRUE(LoadSceneFromString(avg.resolved_yaml, "again.yaml").model.antilocking[0].stress);
+  }
   // Defaults per class: solids none, fluids node-based on the total strain.
   const LoadedScene solid = LoadSceneFromString(kBase3, "ok.yaml");
   ASSERT_EQ(solid.model.antilocking.size(), 1u);
