@@ -133,7 +133,8 @@ void WriteSummaryJson(const std::string& out_dir, RunSummary& summary) {
 }
 
 // The checkpoints of the run in `out_dir` whose file names sort after `after` (later steps),
-// or all of them when `after` is "".
+// or all of them when `after` is "", and every half-written one (<name>_step_*.h5.tmp, left by a
+// kill during a write: WriteCheckpoint renames a file only once it is complete).
 void RemoveCheckpoints(const std::string& out_dir, const std::string& name,
                        const std::string& after) {
   for (const std::string& path : ListCheckpoints(out_dir, name)) {
@@ -141,6 +142,21 @@ void RemoveCheckpoints(const std::string& out_dir, const std::string& name,
     std::error_code ec;
     std::filesystem::remove(path, ec);
     Log(LogLevel::kDebug, "removed checkpoint " + path);
+  }
+  std::error_code ec;
+  const std::filesystem::path dir = std::filesystem::path(out_dir) / "checkpoints";
+  if (!std::filesystem::is_directory(dir, ec)) return;
+  const std::string prefix = name + "_step_", suffix = ".h5.tmp";
+  std::vector<std::filesystem::path> stale;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string f = e.path().filename().string();
+    if (f.size() > prefix.size() + suffix.size() && f.rfind(prefix, 0) == 0 &&
+        f.compare(f.size() - suffix.size(), suffix.size(), suffix) == 0)
+      stale.push_back(e.path());
+  }
+  for (const auto& path : stale) {
+    std::filesystem::remove(path, ec);
+    LogInfo("removed the half-written checkpoint " + path.string());
   }
 }
 

@@ -41,9 +41,12 @@ else
   bad "dam_checkpoints_kept: expected the newest 3 (the last at step 450): ${ckpts[*]##*/}"
 fi
 oldest=${ckpts[0]}
+# A half-written checkpoint a kill -9 can leave behind: the restart must clear it (listing below).
+printf 'partial' > "$work/part/checkpoints/dam_barrier_step_000000999.h5.tmp"
 expect dam_restart 0 'continuing from .* step [0-9]+' -- "$surge" run "$work/dam.yaml" --restart "$oldest" --progress quiet
 expect dam_bitwise 0 'numeric datasets' -- $compare "$work/full" "$work/part" dam_barrier
-# The restarted run wrote its own checkpoints again; the newest is the full run's newest.
+# The restarted run wrote its own checkpoints again; the newest is the full run's newest; the stale
+# .tmp is gone.
 if cmp -s <(ls "$work/full/checkpoints") <(ls "$work/part/checkpoints"); then ok "dam_checkpoints_after_restart"
 else bad "dam_checkpoints_after_restart: $(ls "$work/part/checkpoints" | tr '\n' ' ')"; fi
 
