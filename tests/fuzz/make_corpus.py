@@ -133,8 +133,11 @@ def io(surge):
     with tempfile.TemporaryDirectory() as tmp:
         scene = os.path.join(tmp, "tiny.yaml")
         open(scene, "w").write(TINY)
-        subprocess.run([surge, "run", scene, "--out", os.path.join(tmp, "out"), "--progress", "quiet",
-                        "--threads", "1"], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        # Relative paths and a bare program name: the result stores the command line and the
+        # scene path, and the committed seeds must not carry this machine's paths.
+        subprocess.run(["surge", "run", "tiny.yaml", "--out", "out", "--progress", "quiet",
+                        "--threads", "1"], executable=surge, cwd=tmp, check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         ck = sorted(glob.glob(os.path.join(tmp, "out/checkpoints/*.h5")))[-1]
         res = os.path.join(tmp, "small.h5")
         shrink(os.path.join(tmp, "out/tiny.h5"), res)
