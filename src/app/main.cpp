@@ -184,13 +184,19 @@ int Main(int argc, char** argv) {
     if (*check) return Check(scene_path, overrides);
     if (*forces) return ForcesCommand(forces_options);
     if (*sweep) return SweepCommand(sweep_options);
-    LoadedScene scene = LoadScene(scene_path, overrides);
     RunOptions options;
-    options.out_dir = out_dir.empty() ? "results/" + scene.model.name : out_dir;
-    // A restart continues the result next to its checkpoint (<out>/checkpoints/...).
-    const std::filesystem::path checkpoint_dir = std::filesystem::path(restart).parent_path();
-    if (out_dir.empty() && !restart.empty() && checkpoint_dir.filename() == "checkpoints")
-      options.out_dir = checkpoint_dir.parent_path().empty() ? "." : checkpoint_dir.parent_path().string();
+    auto resolve_out_dir = [&](const std::string& name) {
+      options.out_dir = out_dir.empty() ? "results/" + name : out_dir;
+      // A restart continues the result next to its checkpoint (<out>/checkpoints/...).
+      const std::filesystem::path checkpoint_dir = std::filesystem::path(restart).parent_path();
+      if (out_dir.empty() && !restart.empty() && checkpoint_dir.filename() == "checkpoints") {
+        options.out_dir =
+            checkpoint_dir.parent_path().empty() ? "." : checkpoint_dir.parent_path().string();
+      }
+      // Refused before the particles are seeded (RunScene checks again).
+      if (restart.empty()) CheckNewRunAllowed(options.out_dir, name, force);
+    };
+    LoadedScene scene = LoadScene(scene_path, overrides, resolve_out_dir);
     options.force = force;
     options.restart = restart;
     options.stop_at_step = stop_at_step;

@@ -5,6 +5,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <chrono>
@@ -174,16 +175,8 @@ bool IsFailedCheckpoint(const std::string& path) {
 // Refuses a new run over an existing result unless options.force, and clears the old result's
 // checkpoints (they would continue a run that is being overwritten).
 void PrepareNewRun(const Model& model, const RunOptions& options) {
-  const std::string h5 = (std::filesystem::path(options.out_dir) / (model.name + ".h5")).string();
+  CheckNewRunAllowed(options.out_dir, model.name, options.force);
   std::error_code ec;
-  if (std::filesystem::exists(h5, ec) && !options.force) {
-    const std::vector<std::string> checkpoints = ListCheckpoints(options.out_dir, model.name);
-    throw RunRefused("'" + h5 + "' exists: pass --force to overwrite it" +
-                     (checkpoints.empty()
-                          ? std::string(", or --out to write elsewhere")
-                          : ", --out to write elsewhere, or --restart " + checkpoints.back() +
-                                " to continue it"));
-  }
   RemoveCheckpoints(options.out_dir, model.name, "");
   // and the old result's diagnostic checkpoint of a failed step, if any
   const std::filesystem::path dir = std::filesystem::path(options.out_dir) / "checkpoints";
@@ -216,6 +209,16 @@ Checkpoint ReadMatchingCheckpoint(const LoadedScene& scene, const RunOptions& op
                      "' (hash " + hash + "); restart with the scene file it was written from");
   }
   if (c.resolved_hash != SceneHash(scene.resolved_yaml)) {
+    // A mesh file whose content changed (its hash is part of the resolved scene) is named first.
+    const auto then = MeshFileHashes(c.resolved_yaml), now = MeshFileHashes(scene.resolved_yaml);
+    for (size_t i = 0; i < std::min(then.size(), now.size()); ++i) {
+      if (then[i].first == now[i].first && then[i].second != now[i].second) {
+        throw RunRefused("mesh file '" + now[i].first + "' changed since checkpoint '" +
+                         options.restart + "' was written (content hash " + then[i].second +
+                         ", now " + now[i].second +
+                         "); restart with the mesh files of the interrupted run");
+      }
+    }
     throw RunRefused("checkpoint '" + options.restart + "' was written from '" + scene.path +
                      "' with other --set overrides (resolved scene hash " + c.resolved_hash +
                      ", now " + SceneHash(scene.resolved_yaml) +
@@ -229,6 +232,17 @@ Checkpoint ReadMatchingCheckpoint(const LoadedScene& scene, const RunOptions& op
 }
 
 }  // namespace
+
+void CheckNewRunAllowed(const std::string& out_dir, const std::string& name, bool force) {
+  const std::string h5 = (std::filesystem::path(out_dir) / (name + ".h5")).string();
+  std::error_code ec;
+  if (force || !std::filesystem::exists(h5, ec)) return;
+  const std::vector<std::string> checkpoints = ListCheckpoints(out_dir, name);
+  throw RunRefused("'" + h5 + "' exists: pass --force to overwrite it" +
+                   (checkpoints.empty() ? std::string(", or --out to write elsewhere")
+                                        : ", --out to write elsewhere, or --restart " +
+                                              checkpoints.back() + " to continue it"));
+}
 
 RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   const Model& model = scene.model;

@@ -63,6 +63,11 @@ struct RunSummary {
 
 // Runs the scene into options.out_dir, or continues the run of options.restart there (the
 // result is cut back to the checkpoint and continued; docs/results-format.md, "Checkpoints").
+// Throws RunRefused when `<out_dir>/<name>.h5` exists and `force` is false, naming --force,
+// --out and the newest checkpoint to --restart from. RunScene checks it again; `surge run` calls
+// it before the scene is built (LoadScene's before_build).
+void CheckNewRunAllowed(const std::string& out_dir, const std::string& name, bool force);
+
 // Throws RunRefused for an existing result without options.force, and for a checkpoint whose
 // scene (text or --set overrides) is not `scene`.
 RunSummary RunScene(LoadedScene& scene, const RunOptions& options);

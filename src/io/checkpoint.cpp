@@ -5,6 +5,7 @@
 
 #include <hdf5.h>
 
+#include "core/hash.h"
 #include "io/h5_handle.h"
 
 #include <algorithm>
@@ -235,16 +236,7 @@ size_t Rows(hid_t loc, const char* name, const std::string& path) {
 
 }  // namespace
 
-std::string SceneHash(const std::string& text) {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a 64 offset basis and prime
-  for (unsigned char ch : text) {
-    h ^= ch;
-    h *= 1099511628211ull;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
+std::string SceneHash(const std::string& text) { return Fnv1aHex(text); }
 
 std::string CheckpointPath(const std::string& out_dir, const std::string& name, int64_t step) {
   char file[64];

@@ -15,9 +15,11 @@ namespace surge {
 namespace {
 
 LoadedScene Load(std::string path, std::string text, const std::string& source,
-                 const std::string& base_dir, const std::vector<std::string>& overrides) {
+                 const std::string& base_dir, const std::vector<std::string>& overrides,
+                 const std::function<void(const std::string&)>& before_build = {}) {
   LoadedScene scene;
   const SceneSpec spec = ParseSceneSpec(text, source, base_dir, overrides);
+  if (before_build) before_build(spec.name);
   BuildScene(spec, scene.model, scene.state);
   scene.path = std::move(path);
   scene.text = std::move(text);
@@ -34,7 +36,8 @@ std::vector<std::string> MaterialModelNames() {
   return names;
 }
 
-LoadedScene LoadScene(const std::string& path, const std::vector<std::string>& overrides) {
+LoadedScene LoadScene(const std::string& path, const std::vector<std::string>& overrides,
+                      const std::function<void(const std::string&)>& before_build) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     const bool exists = std::filesystem::exists(path, ec);
@@ -50,7 +53,7 @@ LoadedScene LoadScene(const std::string& path, const std::vector<std::string>& o
   if (in.bad()) throw SceneError(path, 0, 0, "", "cannot read scene file: read error");
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   const std::string dir = parent.empty() ? std::string(".") : parent.string();
-  return Load(path, std::move(text), path, dir, overrides);
+  return Load(path, std::move(text), path, dir, overrides, before_build);
 }
 
 LoadedScene LoadSceneFromString(const std::string& text, const std::string& name_for_errors,

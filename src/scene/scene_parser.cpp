@@ -5,9 +5,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -15,6 +17,8 @@
 #include <variant>
 #include <set>
 
+#include "core/hash.h"
+#include "scene/scene.h"
 #include "scene/scene_error.h"
 #include "scene/scene_expressions.h"
 #include "scene/scene_spec.h"
@@ -383,6 +387,34 @@ class Parser {
     return n.Scalar();
   }
 
+  // FNV-1a of a mesh file's bytes (core/hash.h), so the resolved scene, and with it the restart
+  // and sweep checks, changes when the mesh does. "" when the file cannot be read: the builder's
+  // mesh reader names that error. A `file_hash` in the map (as a resolved scene carries it) pins
+  // the content: a different file is refused.
+  std::string MeshFileHash(const YAML::Node& map, const std::string& path,
+                           const std::string& file) const {
+    std::string hash;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(file, ec)) {
+      std::ifstream in(file, std::ios::binary);
+      uint64_t h = kFnv1aBasis;
+      std::array<char, 1 << 16> buf;
+      while (in.read(buf.data(), buf.size()) || in.gcount() > 0) {
+        h = Fnv1a(std::string_view(buf.data(), size_t(in.gcount())), h);
+      }
+      if (!in.bad()) hash = HashHex(h);
+    }
+    if (const YAML::Node pinned = map["file_hash"]) {
+      const std::string want = String(pinned, Child(path, "file_hash"));
+      if (!hash.empty() && want != hash) {
+        Fail(pinned, Child(path, "file_hash"),
+             "mesh file '" + file + "' has content hash " + hash + ", not " + want +
+                 " as pinned here: the file changed since this scene was resolved");
+      }
+    }
+    return hash;
+  }
+
   // [A-Za-z0-9_-]+ : used in file names and HDF5 group names.
   std::string Identifier(const YAML::Node& n, const std::string& path) const {
     const std::string s = String(n, path);
@@ -730,7 +762,7 @@ RegionShape Parser::ParseRegion(const YAML::Node& n, const std::string& path) co
   }
   // mesh
   if (dim_ == 2) Fail(n.begin()->first, p, "mesh regions are 3-D only");
-  ExpectMap(s, p, {"file", "scale", "translate"});
+  ExpectMap(s, p, {"file", "file_hash", "scale", "translate"});
   MeshRegion mesh;
   const YAML::Node file = Need(s, p, "file");
   const std::filesystem::path f = String(file, Child(p, "file"));
@@ -739,6 +771,7 @@ RegionShape Parser::ParseRegion(const YAML::Node& n, const std::string& path) co
                   .lexically_normal()
                   .string();
   mesh.file_loc = Loc(file, Child(p, "file"));
+  mesh.file_hash = MeshFileHash(s, p, mesh.file);
   if (s["scale"]) mesh.scale = Positive(s["scale"], Child(p, "scale"), "-");
   if (s["translate"]) mesh.translate = Vector(s["translate"], Child(p, "translate"), "m");
   return mesh;
@@ -855,7 +888,7 @@ ObstacleShapeSpec Parser::ParseObstacleShape(const YAML::Node& n, const std::str
   }
   if (kind == "mesh") {
     if (dim_ == 2) Fail(n.begin()->first, p, "mesh obstacles are 3-D only (in 2-D use polygon)");
-    ExpectMap(s, p, {"file", "scale", "rotate_deg", "translate", "one_sided", "faces"});
+    ExpectMap(s, p, {"file", "file_hash", "scale", "rotate_deg", "translate", "one_sided", "faces"});
     ObstacleMeshSpec mesh;
     const YAML::Node file = Need(s, p, "file");
     const std::filesystem::path f = String(file, Child(p, "file"));
@@ -863,6 +896,7 @@ ObstacleShapeSpec Parser::ParseObstacleShape(const YAML::Node& n, const std::str
                     .lexically_normal()
                     .string();
     mesh.file_loc = Loc(file, Child(p, "file"));
+    mesh.file_hash = MeshFileHash(s, p, mesh.file);
     if (s["scale"]) mesh.scale = Positive(s["scale"], Child(p, "scale"), "-");
     if (s["rotate_deg"]) mesh.rotate_deg = Vector(s["rotate_deg"], Child(p, "rotate_deg"), "deg");
     if (s["translate"]) mesh.translate = Vector(s["translate"], Child(p, "translate"), "m");
@@ -1402,6 +1436,7 @@ void EmitRegion(YAML::Emitter& e, const RegionShape& region, int dim) {
   } else if (const auto* mesh = std::get_if<MeshRegion>(&region)) {
     e << YAML::Key << "mesh" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "file" << YAML::Value << mesh->file;
+    if (!mesh->file_hash.empty()) e << YAML::Key << "file_hash" << YAML::Value << mesh->file_hash;
     e << YAML::Key << "scale" << YAML::Value << Num(mesh->scale);
     e << YAML::Key << "translate" << YAML::Value;
     EmitVector(e, mesh->translate, dim);
@@ -1469,6 +1504,7 @@ void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
   } else if (const auto* mesh = std::get_if<ObstacleMeshSpec>(&o.shape)) {
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "mesh" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "file" << YAML::Value << mesh->file;
+    if (!mesh->file_hash.empty()) e << YAML::Key << "file_hash" << YAML::Value << mesh->file_hash;
     e << YAML::Key << "scale" << YAML::Value << Num(mesh->scale);
     e << YAML::Key << "rotate_deg" << YAML::Value;
     EmitVector(e, mesh->rotate_deg, dim);
@@ -1750,6 +1786,28 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   }
   e << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
+}
+
+namespace {
+void CollectMeshFileHashes(const YAML::Node& n, std::vector<std::pair<std::string, std::string>>& out) {
+  if (n.IsMap()) {
+    const YAML::Node file = n["file"], hash = n["file_hash"];
+    if (file && hash && file.IsScalar() && hash.IsScalar()) out.emplace_back(file.Scalar(), hash.Scalar());
+    for (const auto& kv : n) CollectMeshFileHashes(kv.second, out);
+  } else if (n.IsSequence()) {
+    for (const auto& child : n) CollectMeshFileHashes(child, out);
+  }
+}
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> MeshFileHashes(const std::string& resolved_yaml) {
+  std::vector<std::pair<std::string, std::string>> out;
+  try {
+    CollectMeshFileHashes(YAML::Load(resolved_yaml), out);
+  } catch (const YAML::Exception&) {
+    out.clear();
+  }
+  return out;
 }
 
 }  // namespace surge

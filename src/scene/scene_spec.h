@@ -155,6 +155,7 @@ struct PolygonRegion {  // simple polygon in the xy plane, extruded over [z0, z1
 };
 struct MeshRegion {  // 3-D only: the inside of a closed triangle mesh
   std::string file;   // resolved path (relative paths are taken from the scene file's directory)
+  std::string file_hash;  // FNV-1a of the file's bytes (core/hash.h); "" when it cannot be read
   Real scale = 1;     // vertices are scaled, then translated [-]
   Vec3 translate = Vec3::Zero();  // [m]
   SourceLoc file_loc;
@@ -186,6 +187,7 @@ struct BodySpec {
 // reuse the region shapes; a plane and a mesh have their own.
 struct ObstacleMeshSpec {
   std::string file;                 // resolved path (as MeshRegion)
+  std::string file_hash;            // as MeshRegion
   Real scale = 1;                   // [-]
   Vec3 rotate_deg = Vec3::Zero();   // rotations about x, then y, then z [deg]
   Vec3 translate = Vec3::Zero();    // [m], applied last

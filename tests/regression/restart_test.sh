@@ -19,8 +19,9 @@
 #      difference of any float dataset 8.8e-12 (docs/robustness.md); checked below 1e-9.
 #   3. Refusals (exit 2): a rerun into an existing result without --force (the message names the
 #      file and offers --force and --restart), a checkpoint restarted with another scene (both
-#      files named) or other --set overrides, a file that is not a checkpoint, a scene name with
-#      a path in it. --force replaces the result and clears the old run's checkpoints.
+#      files named) or other --set overrides or a changed mesh file (named), a file that is not a
+#      checkpoint, a scene name with a path in it; the existing-result refusal comes before the
+#      scene is built. --force replaces the result and clears the old run's checkpoints.
 # Usage: restart_test.sh <surge binary> <source dir>. Measured: 15.5 s in the full ctest run (2 cores).
 set -u
 surge=$1
@@ -98,6 +99,20 @@ expect other_scene_refused 2 "checkpoint '.*dam_barrier_step_[0-9]+\.h5' was wri
   -- "$surge" run "$work/dam_edited.yaml" --restart "$newest" --progress quiet
 expect other_set_refused 2 'other --set overrides' \
   -- "$surge" run "$work/dam.yaml" --restart "$newest" --set time.end=0.4 --progress quiet
+# The result-exists refusal comes before the scene is built: this cell size would otherwise be
+# refused by the memory check (or seed for minutes).
+expect exists_refused_before_seeding 2 "full/dam_barrier\.h5' exists: pass --force" \
+  -- "$surge" run "$work/dam.yaml" --out "$work/full" --progress quiet --set grid.cell_size=1e-5
+# A mesh file's content is part of the resolved scene (its FNV-1a hash): a restart after the
+# mesh changed is refused naming the file.
+mkdir -p "$work/meshes"
+cp "$src/tests/data/meshes/unit_cube.obj" "$work/meshes/"
+sed -e 's/^time: .*/time: {end: 0.01}/' -e 's|\.\./meshes/|meshes/|' -e '$a output: {checkpoint_every: 1.0}' \
+  "$src/tests/data/scenes/mesh_cube.yaml" > "$work/mesh_cube.yaml"
+expect mesh_stopped 130 'interrupted at t' -- "$surge" run "$work/mesh_cube.yaml" --out "$work/mesh" --progress quiet --stop-at-step 3
+echo "# edited" >> "$work/meshes/unit_cube.obj"
+expect mesh_changed_refused 2 "mesh file '.*/meshes/unit_cube\.obj' changed since checkpoint '.*mesh_cube_step_000000003\.h5' was written \(content hash [0-9a-f]{16}, now [0-9a-f]{16}\)" \
+  -- "$surge" run "$work/mesh_cube.yaml" --restart "$work/mesh/checkpoints/mesh_cube_step_000000003.h5" --progress quiet
 expect not_a_checkpoint 2 'is not a Surge checkpoint' \
   -- "$surge" run "$work/dam.yaml" --restart "$work/full/dam_barrier.h5" --out "$work/full" --progress quiet
 expect missing_checkpoint 2 'no such file' \

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "contact/geometry.h"
+#include "core/hash.h"
 #include "scene/scene.h"
 
 namespace surge {
@@ -271,7 +272,7 @@ TEST(ObstacleParserTest, UnknownKeys) {
               "unknown key 'torus' (expected one of: plane, box, sphere, cylinder, polygon, mesh)");
   ExpectError(WithObstacle(3, "{name: c, shape: {mesh: {file: " + kMeshDir + "unit_cube.stl, scal: 2}}}\n"), 13,
               "obstacles[0].shape.mesh.scal",
-              "unknown key 'scal' (expected one of: file, scale, rotate_deg, translate, one_sided, faces)");
+              "unknown key 'scal' (expected one of: file, file_hash, scale, rotate_deg, translate, one_sided, faces)");
   ExpectError(Base(3) + "obstacles: {name: c}\n", 12, "obstacles", "expected a list of obstacles");
 }
 
@@ -488,6 +489,44 @@ TEST(ObstacleResolvedYamlTest, EveryKindRereadsToTheSameYaml2D) {
 TEST(ObstacleResolvedYamlTest, NoObstaclesKeyWithoutObstacles) {
   const LoadedScene a = LoadSceneFromString(Base(3), "s.yaml");
   EXPECT_EQ(a.resolved_yaml.find("obstacles"), std::string::npos) << a.resolved_yaml;
+}
+
+// A mesh file's bytes are hashed into the resolved scene (FNV-1a, core/hash.h), so a restart or a
+// sweep notices a changed mesh; a resolved scene pins that content.
+TEST(ObstacleResolvedYamlTest, MeshFileContentHashIsResolvedAndPinned) {
+  const std::string dir = ::testing::TempDir() + "mesh_hash_test/";
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kMeshDir + "unit_cube.stl", dir + "cube.stl",
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::string text = WithObstacle(
+      3, "{name: m, shape: {mesh: {file: " + dir + "cube.stl, scale: 0.25, translate: [1.25, 0, 0]}}}\n");
+  const LoadedScene a = LoadSceneFromString(text, "s.yaml");
+  const auto hashes = MeshFileHashes(a.resolved_yaml);
+  ASSERT_EQ(hashes.size(), 1u) << a.resolved_yaml;
+  EXPECT_EQ(hashes[0].first, dir + "cube.stl");
+  std::ifstream in(dir + "cube.stl", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(hashes[0].second, Fnv1aHex(bytes));
+  // Re-read as written: the same resolved scene.
+  EXPECT_EQ(LoadSceneFromString(a.resolved_yaml, "resolved.yaml").resolved_yaml, a.resolved_yaml);
+  // One more byte in the mesh: the resolved scene changes, and the pinned one is refused naming
+  // its file_hash key.
+  { std::ofstream(dir + "cube.stl", std::ios::app) << "\n"; }
+  const LoadedScene b = LoadSceneFromString(text, "s.yaml");
+  EXPECT_NE(b.resolved_yaml, a.resolved_yaml);
+  EXPECT_NE(MeshFileHashes(b.resolved_yaml).at(0).second, hashes[0].second);
+  try {
+    LoadSceneFromString(a.resolved_yaml, "resolved.yaml");
+    ADD_FAILURE() << "a changed mesh was accepted against its pinned hash";
+  } catch (const SceneError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("resolved.yaml:"), std::string::npos) << what;
+    EXPECT_NE(what.find("obstacles[0].shape.mesh.file_hash"), std::string::npos) << what;
+    EXPECT_NE(what.find("the file changed since this scene was resolved"), std::string::npos) << what;
+  }
+  // A missing file has no hash; the mesh reader's own error names it.
+  std::filesystem::remove(dir + "cube.stl");
+  EXPECT_THROW(LoadSceneFromString(text, "s.yaml"), SceneError);
 }
 
 // --- carving ------------------------------------------------------------------------------------
