@@ -29,6 +29,8 @@
 #include <vector>
 
 #include "app/run.h"
+#include "core/hash.h"
+#include "io/checkpoint.h"
 #include "io/result_status.h"
 #include "scene/scene.h"
 #include "scene/sweep.h"
@@ -99,17 +101,8 @@ struct CaseScene {
 
 // FNV-1a (64 bit) of the resolved scene (every key, defaults filled in, after the overrides and
 // expressions), in hex: a case whose scene changed since it ran is outdated. Comments and
-// layout of the scene file do not count; mesh file contents do not either.
-std::string SceneDigest(const std::string& resolved_yaml) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char ch : resolved_yaml) {
-    h ^= ch;
-    h *= 1099511628211ull;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
+// layout of the scene file do not count; the mesh files do, through their content hashes in it.
+std::string SceneDigest(const std::string& resolved_yaml) { return Fnv1aHex(resolved_yaml); }
 
 // Everything known about one case: its folder, how it last ran, its summary.
 struct CaseView {
@@ -121,6 +114,7 @@ struct CaseView {
   int exit_code = -1;
   double wall_seconds = 0;
   std::string detail;      // why it is not completed
+  std::string resumed_from;  // the checkpoint the running case continues from; "" if from t = 0
 };
 
 // Reads the state of case `c` from its folder. `known` comes from validating the case; without
@@ -240,8 +234,17 @@ class Runner {
  public:
   Runner(const SweepSpec& spec, std::string exe) : spec_(spec), exe_(std::move(exe)) {}
 
-  // Starts `surge run` for the case; its stdout and stderr go to <case dir>/log.txt.
-  pid_t Start(CaseView& v) {
+  // Starts `surge run` for the case; its stdout and stderr go to <case dir>/log.txt. An
+  // interrupted or incomplete case with a checkpoint of its own continues from the newest one
+  // when `resume` (`surge run --restart`, bitwise the same result as an uninterrupted run);
+  // otherwise it starts over.
+  pid_t Start(CaseView& v, bool resume) {
+    v.resumed_from.clear();
+    if (resume && (v.status == "interrupted" || v.status == "incomplete") && !v.h5.empty()) {
+      const std::vector<std::string> checkpoints =
+          ListCheckpoints(v.dir, fs::path(v.h5).stem().string());
+      if (!checkpoints.empty()) v.resumed_from = checkpoints.back();
+    }
     fs::create_directories(v.dir);
     std::error_code ec;
     fs::remove(fs::path(v.dir) / "summary.json", ec);  // no stale summary if this run fails
@@ -258,7 +261,13 @@ class Runner {
     // (failed, interrupted, outdated) is replaced.
     std::vector<std::string> args = {exe_, "run", Absolute(spec_.base), "--out", v.dir,
                                      "--threads", std::to_string(spec_.threads_per_case),
-                                     "--progress", "quiet", "--force"};
+                                     "--progress", "quiet"};
+    if (v.resumed_from.empty()) {
+      args.push_back("--force");
+    } else {
+      args.push_back("--restart");
+      args.push_back(v.resumed_from);
+    }
     for (const std::string& o : record.overrides) {
       args.push_back("--set");
       args.push_back(o);
@@ -271,7 +280,9 @@ class Runner {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    // A resumed case appends to the log of the run it continues.
+    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(),
+                                     O_WRONLY | O_CREAT | (v.resumed_from.empty() ? O_TRUNC : O_APPEND), 0644);
     posix_spawn_file_actions_adddup2(&actions, 1, 2);
     // Own process group: a terminal Ctrl-C reaches only the sweep, which passes it on to every
     // case; a SIGINT or SIGTERM sent to the sweep alone (kill, Slurm) stops the cases as well.
@@ -350,8 +361,9 @@ std::string CaseLine(const CaseView& v) {
 }
 
 // Runs the cases `todo` (indices into views), `jobs` at a time. Returns true unless stopped.
+// `resume`: interrupted cases continue from their newest checkpoint (Runner::Start).
 bool RunCases(const SweepSpec& spec, std::vector<CaseView>& views, const std::vector<size_t>& todo,
-              int jobs, int skipped) {
+              int jobs, int skipped, bool resume) {
   Runner runner(spec, ExePath());
   SignalGuard guard;
   const bool tty = isatty(STDERR_FILENO);
@@ -411,7 +423,8 @@ bool RunCases(const SweepSpec& spec, std::vector<CaseView>& views, const std::ve
     bool changed = false;
     while (forwarded == 0 && running.size() < size_t(jobs) && next < todo.size()) {
       CaseView& v = views[todo[next++]];
-      running.push_back({size_t(&v - views.data()), runner.Start(v), Clock::now()});
+      running.push_back({size_t(&v - views.data()), runner.Start(v, resume), Clock::now()});
+      if (!v.resumed_from.empty()) print(v.c->name + ": continuing from " + v.resumed_from);
       changed = true;
     }
     if (running.empty()) break;
@@ -424,6 +437,14 @@ bool RunCases(const SweepSpec& spec, std::vector<CaseView>& views, const std::ve
       }
       const double wall = std::chrono::duration<double>(Clock::now() - running[i].start).count();
       CaseView& v = views[running[i].view];
+      // A checkpoint that `surge run --restart` refuses (exit 2: unreadable, or not this case's):
+      // the case starts over instead.
+      if (!v.resumed_from.empty() && r > 0 && WIFEXITED(status) && WEXITSTATUS(status) == kExitBadInput &&
+          forwarded == 0) {
+        print(v.c->name + ": " + v.resumed_from + " refused (see the log), starting over");
+        running[i].pid = runner.Start(v, /*resume=*/false);
+        continue;
+      }
       runner.Finish(v, r < 0 ? (kExitFailure << 8) : status, wall);
       ++done;
       wall_sum += wall;
@@ -487,7 +508,9 @@ CLI::App* AddSweepSubcommand(CLI::App& app, SweepCommandOptions& o) {
       ->check(CLI::Range(1, 4096));
   sweep->add_option("--out,-o", o.out, "Results folder (default: the sweep file's out)");
   sweep->add_flag("--dry-run,-n", o.dry_run, "Validate and list the cases and their overrides");
-  sweep->add_flag("--force", o.force, "Rerun cases that already completed");
+  sweep->add_flag("--force", o.force,
+                  "Rerun every case from the start, completed ones included (without it completed "
+                  "cases are skipped and interrupted ones continue from their newest checkpoint)");
   sweep->add_option("--case", o.case_index, "Run only case I (0-based; a Slurm array task)")
       ->check(CLI::NonNegativeNumber);
   sweep->add_flag("--collect", o.collect, "Only rebuild <out>/sweep.csv from the case folders");
@@ -568,7 +591,7 @@ int SweepCommand(const SweepCommandOptions& o) {
       std::printf("%s already completed (--force reruns it)\n", views[0].c->name.c_str());
       return kExitOk;
     }
-    const bool finished = RunCases(spec, views, todo, 1, 0);
+    const bool finished = RunCases(spec, views, todo, 1, 0, !o.force);
     if (!finished) return kExitInterrupted;
     return views[0].status == "completed" ? kExitOk : kExitFailure;
   }
@@ -588,7 +611,7 @@ int SweepCommand(const SweepCommandOptions& o) {
   std::printf("sweep %s: %d cases, %zu to run (%d completed before), %d at a time x %d thread(s); results in %s\n",
               spec.path.c_str(), n, todo.size(), skipped, jobs, spec.threads_per_case, spec.out.c_str());
   std::fflush(stdout);
-  const bool finished = RunCases(spec, views, todo, jobs, skipped);
+  const bool finished = RunCases(spec, views, todo, jobs, skipped, !o.force);
   const int code = Summarise(views, WriteCsv(spec, views));
   return finished ? code : kExitInterrupted;
 }
