@@ -15,6 +15,8 @@
 #include <cstring>
 #include <filesystem>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -25,7 +27,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kFormat = "surge-checkpoint";
-constexpr int kFormatVersion = 1;
+// 2: the file starts with the checksum user block (ChecksumBlock).
+constexpr int kFormatVersion = 2;
 
 // The State's element types are stored as rows of doubles: no padding may hide in them.
 static_assert(sizeof(Vec3) == 3 * sizeof(double) && sizeof(Mat3) == 9 * sizeof(double),
@@ -53,6 +56,91 @@ void SyncPath(const std::string& path, bool folder) {
   const int err = errno;
   ::close(fd);
   if (rc != 0) throw IoError("checkpoint: cannot sync '" + path + "': " + std::strerror(err));
+}
+
+// --- checksum ---
+// The first kUserBlock bytes of a checkpoint are an HDF5 user block (H5Pset_userblock; HDF5
+// ignores it and finds its superblock after it). Once the HDF5 file is closed, Surge writes there
+// "surge-checkpoint fnv1a64 <16 hex digits> bytes <n>\n": the FNV-1a hash (core/hash.h) and the
+// length of everything after the block. ReadCheckpoint checks both before HDF5 reads a byte, so a
+// damaged or truncated checkpoint is refused with a message instead of reaching libhdf5, which on
+// some corrupt files reads out of bounds or allocates without limit (docs/robustness.md,
+// third-party findings).
+constexpr size_t kUserBlock = 512;
+constexpr const char* kChecksumTag = "surge-checkpoint fnv1a64 ";
+
+// FNV-1a hash and length of the bytes of `fd` from offset kUserBlock to the end.
+std::pair<uint64_t, uint64_t> HashAfterUserBlock(int fd, const std::string& path) {
+  std::vector<char> buf(size_t(1) << 20);
+  uint64_t h = kFnv1aBasis, n = 0;
+  off_t at = off_t(kUserBlock);
+  while (true) {
+    const ssize_t got = ::pread(fd, buf.data(), buf.size(), at);
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      throw IoError("checkpoint '" + path + "': cannot read it: " + std::strerror(errno));
+    }
+    if (got == 0) break;
+    h = Fnv1a(std::string_view(buf.data(), size_t(got)), h);
+    n += uint64_t(got);
+    at += got;
+  }
+  return {h, n};
+}
+
+// Writes the checksum block of the closed HDF5 file `path`.
+void WriteChecksumBlock(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0) throw IoError("checkpoint '" + path + "': cannot reopen it: " + std::strerror(errno));
+  try {
+    const auto [h, n] = HashAfterUserBlock(fd, path);
+    std::array<char, kUserBlock> block{};
+    std::snprintf(block.data(), block.size(), "%s%s bytes %llu\n", kChecksumTag, HashHex(h).c_str(),
+                  static_cast<unsigned long long>(n));
+    if (::pwrite(fd, block.data(), block.size(), 0) != ssize_t(block.size())) {
+      throw IoError("checkpoint '" + path + "': cannot write its checksum: " + std::strerror(errno));
+    }
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::close(fd);
+}
+
+// Checks the checksum block of `path`. Returns false when the file has none (not a checkpoint
+// of this format: the HDF5 checks that follow say what it is); throws IoError when it has one
+// and the rest of the file does not match it.
+bool VerifyChecksumBlock(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError("checkpoint '" + path + "': cannot open it: " + std::strerror(errno));
+  std::array<char, kUserBlock + 1> block{};
+  ssize_t got = ::pread(fd, block.data(), kUserBlock, 0);
+  const size_t tag = std::strlen(kChecksumTag);
+  unsigned long long want_n = 0;
+  char want_hex[17] = {};
+  if (got < ssize_t(tag) || std::memcmp(block.data(), kChecksumTag, tag) != 0 ||
+      std::sscanf(block.data() + tag, "%16[0-9a-f] bytes %llu", want_hex, &want_n) != 2) {
+    ::close(fd);
+    return false;
+  }
+  std::pair<uint64_t, uint64_t> have;
+  try {
+    have = HashAfterUserBlock(fd, path);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::close(fd);
+  if (have.second != want_n) {
+    throw IoError("checkpoint '" + path + "' is damaged: " + std::to_string(have.second) +
+                  " bytes after its header, " + std::to_string(want_n) +
+                  " when it was written (truncated or appended to); restart from another checkpoint");
+  }
+  if (HashHex(have.first) != want_hex) {
+    throw IoError("checkpoint '" + path + "' is damaged: content hash " + HashHex(have.first) +
+                  ", " + want_hex + " when it was written; restart from another checkpoint");
+  }
+  return true;
 }
 
 // --- writing ---
@@ -271,7 +359,9 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
   const std::string tmp = path + ".tmp";
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   {
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    Handle fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
+    Require(fcpl.ok() && H5Pset_userblock(fcpl.get(), kUserBlock) >= 0, "set up the file", tmp);
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, fcpl.get(), H5P_DEFAULT), H5Fclose);
     Require(file.ok(), "create the file", tmp);
     const hid_t f = file.get();
     const State& s = c.state;
@@ -364,6 +454,7 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
     }
     Require(H5Fflush(f, H5F_SCOPE_GLOBAL) >= 0, "flush the file", tmp);
   }
+  WriteChecksumBlock(tmp);
   // Whole on disk before it gets its final name, and the rename itself on disk after it: the
   // write-fsync-rename-fsync(folder) sequence of an atomic replace.
   SyncPath(tmp, false);
@@ -372,9 +463,10 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
   SyncPath(dir.empty() ? std::string(".") : dir.string(), true);
 }
 
-Checkpoint ReadCheckpoint(const std::string& path) {
+Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw IoError("checkpoint '" + path + "': no such file");
+  const bool verified = verify_checksum && VerifyChecksumBlock(path);
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   if (H5Fis_hdf5(path.c_str()) <= 0) throw IoError("checkpoint '" + path + "' is not an HDF5 file");
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
@@ -386,6 +478,10 @@ Checkpoint ReadCheckpoint(const std::string& path) {
   if (version != kFormatVersion) {
     throw IoError("checkpoint '" + path + "' has format version " + std::to_string(version) +
                   "; this surge reads version " + std::to_string(kFormatVersion));
+  }
+  if (verify_checksum && !verified) {
+    throw IoError("checkpoint '" + path + "' is damaged: its checksum header is missing or "
+                  "unreadable; restart from another checkpoint");
   }
   Checkpoint c;
   c.name = ReadString(f, "name", false, path);

@@ -52,8 +52,10 @@ std::vector<std::string> ListCheckpoints(const std::string& out_dir, const std::
 // always whole; creates the folder. Throws IoError naming the file on failure.
 void WriteCheckpoint(const std::string& path, const Checkpoint& c);
 
-// Reads a checkpoint. Throws IoError naming the file when it is missing, not HDF5, not a Surge
-// checkpoint, of another format version, or inconsistent (array lengths).
-Checkpoint ReadCheckpoint(const std::string& path);
+// Reads a checkpoint. Throws IoError naming the file when it is missing, damaged (its bytes do
+// not match the checksum written with it, checked before HDF5 opens it), not HDF5, not a Surge
+// checkpoint, of another format version, or inconsistent (array lengths). `verify_checksum`
+// false skips the checksum (tests/fuzz/fuzz_io.cpp, which fuzzes what lies behind it).
+Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum = true);
 
 }  // namespace surge
