@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <type_traits>
 #include <variant>
 
@@ -75,19 +76,18 @@ void ObstacleWarnings(const Model& m, std::vector<std::string>& out) {
 std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
   std::vector<std::string> out;
   const Model& m = scene.model;
+  // With transfer: apic the blow-up comes even in free translation (docs/stability.md, "Linear
+  // shape functions with APIC": 32 ms at Courant number 0.4, USL's stress update takes the full
+  // increment of a node that a particle has just reached); linear + apic + musl is stable since
+  // issue #8's fix and gets no warning.
   if (m.shape == ShapeFunction::kLinear && m.scheme == UpdateScheme::kUsl)
     out.push_back(
-        "grid: linear shape functions with update: usl suffer the cell-crossing instability; "
-        "consider grid.update: musl or a B-spline (docs/validation.md)");
-  // Measured (docs/stability.md, "Linear shape functions with APIC"): an elastic block translating
-  // freely at 2 m/s grows its round-off stress from 6e-10 Pa at 5 ms to 0.15 Pa at 20 ms and
-  // blows up (energy x3) at 32 ms, with USL and MUSL; FLIP with linear, and APIC with GIMP or
-  // B-splines, run it to the end. Cause not found yet (issue #8).
-  if (m.shape == ShapeFunction::kLinear && m.transfer == TransferScheme::kApic)
-    out.push_back(
-        "grid: linear shape functions with transfer: apic are unstable in Surge (round-off grows "
-        "until the run blows up, even in free translation); use transfer: flip or pic_flip with "
-        "linear, or gimp / a B-spline with apic (docs/stability.md)");
+        std::string("grid: linear shape functions with update: usl suffer the cell-crossing "
+                    "instability") +
+        (m.transfer == TransferScheme::kApic
+             ? " (with transfer: apic even a freely translating body blows up)"
+             : "") +
+        "; consider grid.update: musl or a B-spline (docs/validation.md, docs/stability.md)");
 
   // Weak compressibility holds while the flow Mach number stays below about 0.1 (Monaghan 1994:
   // density fluctuations scale with Ma^2, so Ma < 0.1 keeps them below 1 %). Flow speed estimate

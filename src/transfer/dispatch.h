@@ -29,8 +29,10 @@ void DispatchKernel(int dim, ShapeFunction shape, F&& f) {
 
 // APIC: C_p = B_p D_p^{-1} (Jiang et al. 2015, eq. (7)). B-splines have D_p = dx^2/kInvDScale I
 // (§5.3); for the multilinear kernel B_p D_p^{-1} equals sum_i v_i (grad N_ip)^T (§5.3), i.e. the
-// velocity gradient; GIMP uses the general D_p = sum_i N_ip (x_i - x_p)(x_i - x_p)^T, which is
-// diagonal for tensor-product kernels with linear reproduction.
+// velocity gradient, which G2P takes of the start-of-step velocities only and adds the step's
+// increment with D_p = dx^2/4 I (grid_to_particle.cpp, docs/stability.md); GIMP uses the general
+// D_p = sum_i N_ip (x_i - x_p)(x_i - x_p)^T, diagonal for tensor-product kernels with linear
+// reproduction.
 template <class K>
 constexpr bool kApicUsesGradient = std::is_same_v<K, LinearKernel>;
 template <class K>

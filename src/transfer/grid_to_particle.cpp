@@ -12,7 +12,8 @@
 namespace surge {
 namespace {
 
-// Halo node layouts: APIC and the velocity gradient need only v_{i,n+1}; FLIP also v_{i,n}.
+// Halo node layouts: APIC and the velocity gradient need only v_{i,n+1}; FLIP and APIC with the
+// linear kernel also v_{i,n}.
 // Keeping the APIC halo at 24 bytes per node lets a 10^3-node halo stay in L1.
 struct NodeV1 {
   Real v1[3];  // v_{i,n+1}
@@ -64,7 +65,9 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
   using Pad = BlockPad<kDim, K>;
   const Real alpha = kMode == G2PMode::kFlip ? 1.0 : model.flip_ratio;
   ParallelFor(grid.block_count(), 1, [&](size_t blk) {
-    using Node = std::conditional_t<kMode == G2PMode::kApic, NodeV1, NodeV01>;
+    // Linear APIC also reads v_{i,n} (the affine increment below).
+    using Node =
+        std::conditional_t<kMode == G2PMode::kApic && !kApicUsesGradient<K>, NodeV1, NodeV01>;
     thread_local std::vector<Node> halo;
     GatherHalos<kDim, K>(grid, blk, halo);
     const Vec3i origin = grid.block_origin[blk];
@@ -164,7 +167,30 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
       if constexpr (kMode == G2PMode::kApic) {
         P.v[p] = v_pic;  // APIC velocity (Jiang et al. 2015, eq. (8))
         if constexpr (kApicUsesGradient<K>) {
-          P.C[p] = L;
+          // Linear kernel: the start-of-step field's exact affine matrix plus the step's increment
+          // projected with a constant D (docs/stability.md, "Linear shape functions with APIC"):
+          //   C_p = sum_i v_{i,n} (grad N_ip)^T
+          //       + (4 / dx^2) sum_i N_ip (v_{i,n+1} - v_{i,n}) (x_i - x_p)^T.
+          // The first term is B_p D_p^{-1} of Jiang et al. 2015, eq. (7), which for multilinear N
+          // equals the gradient form (§5.3); the second is eq. (7) with D_p = dx^2/4 I (§5.3, the
+          // quadratic B-spline's D and the largest D_p of the linear kernel). Taking the whole
+          // C_p = sum v_{i,n+1} (grad N_ip)^T instead hands a node that a particle has just reached
+          // (mass N_ip m_p -> 0, |grad N_ip| = 1/dx, acceleration ~ 1/N_ip) its full explicit
+          // increment back through the next P2G: with linear weights the affine round trip is
+          // lossless, so that node's velocity is kept from step to step and its tiny mass makes
+          // the explicit update unstable below the wave-speed CFL limit. Weighting the increment
+          // by N_ip, as the B-splines' B_p D_p^{-1} does, bounds it.
+          Mat3 c0 = Mat3::Zero(), db = Mat3::Zero();
+          for (int i = 0; i < st.W; ++i)
+            for (int j = 0; j < st.W; ++j)
+              for (int k = 0; k < st.Wz; ++k) {
+                const Node& n = field_halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + k)];
+                const Vec3 v0(n.v0[0], n.v0[1], n.v0[2]), v1(n.v1[0], n.v1[1], n.v1[2]);
+                const Vec3 o(off[0][i], off[1][j], kDim == 3 ? off[2][k] : 0.0);
+                c0 += v0 * st.Gradient(i, j, k).transpose();
+                db += st.Weight(i, j, k) * (v1 - v0) * o.transpose();
+              }
+          P.C[p] = c0 + (4.0 * ctx.inv_dx * ctx.inv_dx) * db;
         } else if constexpr (kApicConstantD<K>) {
           P.C[p] = (K::kInvDScale * ctx.inv_dx * ctx.inv_dx) * B;  // B D^{-1}, eq. (7)
         } else {
