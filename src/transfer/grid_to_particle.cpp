@@ -180,17 +180,33 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
           // lossless, so that node's velocity is kept from step to step and its tiny mass makes
           // the explicit update unstable below the wave-speed CFL limit. Weighting the increment
           // by N_ip, as the B-splines' B_p D_p^{-1} does, bounds it.
-          Mat3 c0 = Mat3::Zero(), db = Mat3::Zero();
+          // Separable sums as in the loop above: per (i, j) the k sums a0 = sum w_k v0,
+          // a1 = sum g_k v0, d0 = sum w_k dv, d2 = sum w_k oz_k dv (dv = v1 - v0), then the
+          // columns of sum v0 (grad N)^T (c) and of sum N dv (x_i - x_p)^T (b).
+          Vec3 c[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+          Vec3 b[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
           for (int i = 0; i < st.W; ++i)
-            for (int j = 0; j < st.W; ++j)
+            for (int j = 0; j < st.W; ++j) {
+              const Node* row = &field_halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
+              Vec3 a0 = Vec3::Zero(), a1 = Vec3::Zero(), d0 = Vec3::Zero(), d2 = Vec3::Zero();
               for (int k = 0; k < st.Wz; ++k) {
-                const Node& n = field_halo[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + k)];
-                const Vec3 v0(n.v0[0], n.v0[1], n.v0[2]), v1(n.v1[0], n.v1[1], n.v1[2]);
-                const Vec3 o(off[0][i], off[1][j], kDim == 3 ? off[2][k] : 0.0);
-                c0 += v0 * st.Gradient(i, j, k).transpose();
-                db += st.Weight(i, j, k) * (v1 - v0) * o.transpose();
+                const Vec3 v0(row[k].v0[0], row[k].v0[1], row[k].v0[2]);
+                const Vec3 dv = Vec3(row[k].v1[0], row[k].v1[1], row[k].v1[2]) - v0;
+                a0 += st.w[2][k] * v0;
+                a1 += st.g[2][k] * v0;
+                d0 += st.w[2][k] * dv;
+                d2 += wz_oz[k] * dv;
               }
-          P.C[p] = c0 + (4.0 * ctx.inv_dx * ctx.inv_dx) * db;
+              const Real wxy = st.w[0][i] * st.w[1][j];
+              c[0] += (st.g[0][i] * st.w[1][j]) * a0;
+              c[1] += (st.w[0][i] * st.g[1][j]) * a0;
+              c[2] += wxy * a1;
+              b[0] += (wxy * off[0][i]) * d0;
+              b[1] += (wxy * off[1][j]) * d0;
+              b[2] += wxy * d2;
+            }
+          const Real inv_d = 4.0 * ctx.inv_dx * ctx.inv_dx;  // D_p^{-1} = 4/dx^2 I
+          for (int col = 0; col < 3; ++col) P.C[p].col(col) = c[col] + inv_d * b[col];
         } else if constexpr (kApicConstantD<K>) {
           P.C[p] = (K::kInvDScale * ctx.inv_dx * ctx.inv_dx) * B;  // B D^{-1}, eq. (7)
         } else {
