@@ -282,6 +282,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   Workspace work;
   for (const RigidBodyState& b : resume.bullet)
     work.rigid_restart.push_back({b.position, b.rotation, b.velocity, b.angular_velocity});
+  work.rigid_restart_contacts = std::move(resume.bullet_contacts);
   if (restart) {  // what the last step handed to the next one (io/checkpoint.h)
     work.bulk_viscosity.q = std::move(resume.bulk_viscosity_q);
     work.bulk_viscosity.id = std::move(resume.bulk_viscosity_id);
@@ -353,6 +354,7 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
         const RigidWorld::BodyState b = work.rigid_world->State(h);
         c.bullet.push_back({b.position, b.rotation, b.velocity, b.angular_velocity});
       }
+      c.bullet_contacts = work.rigid_world->ContactCache();
     }
     c.bulk_viscosity_q = work.bulk_viscosity.q;
     c.bulk_viscosity_id = work.bulk_viscosity.id;

@@ -418,6 +418,8 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
                  tmp);
       WriteDoubles(f, "rigid", FlattenRigid(s.rigid).data(), s.rigid.size(), kRigidColumns, tmp);
       WriteDoubles(f, "bullet", FlattenRigid(c.bullet).data(), c.bullet.size(), kRigidColumns, tmp);
+      WriteArray(f, "bullet_contacts", H5T_STD_U8LE, H5T_NATIVE_UINT8, c.bullet_contacts.data(),
+                 c.bullet_contacts.size(), 0, tmp);
     }
     {
       Handle g(H5Gcreate2(f, "workspace", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
@@ -539,6 +541,8 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
     };
     s.rigid = read_rigid("rigid");
     c.bullet = read_rigid("bullet");
+    ReadArray(f, "bullet_contacts", H5T_NATIVE_UINT8, Rows(f, "bullet_contacts", path), 0,
+              c.bullet_contacts, path);
   }
   if (H5Lexists(f, "workspace", H5P_DEFAULT) > 0) {
     Handle g(H5Gopen2(f, "workspace", H5P_DEFAULT), H5Gclose);

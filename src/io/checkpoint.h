@@ -21,6 +21,9 @@ struct Checkpoint {
   // continued Bullet world starts bitwise where the interrupted one stood. Empty when the run
   // had no Bullet world yet.
   std::vector<RigidBodyState> bullet;
+  // Bullet's contact manifolds (RigidWorld::ContactCache): restored with the bodies, so that a
+  // restart during a contact continues bitwise. Empty without a Bullet world.
+  std::vector<uint8_t> bullet_contacts;
   // Workspace values a step hands to the next (everything else in Workspace is rebuilt each
   // step): the artificial bulk viscosity q_p of the last step with the particle ids it belongs to,
   // and its time-step bound (stabilize/bulk_viscosity.h). Empty / 1e300 without bulk viscosity.

@@ -2,11 +2,15 @@
 // (cmake/deps/bullet.cmake); mass properties from closed forms and, for hulls, tetrahedra.
 #include "rigid/rigid_world.h"
 
+#include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
 #include <LinearMath/btConvexHullComputer.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cstring>
+#include <map>
+#include <utility>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -136,12 +140,53 @@ ShapeMassProperties ComputeShapeMassProperties(const RigidShape& shape) {
   return p;
 }
 
+// Key of a contact manifold: the user indices (RigidWorld body index; -1 for the ground plane)
+// of its two bodies, in the manifold's own order.
+std::pair<int, int> ManifoldKey(const btPersistentManifold& m) {
+  return {m.getBody0()->getUserIndex(), m.getBody1()->getUserIndex()};
+}
+
+// Puts the dispatcher's contact manifolds in the order of their keys. The sequential-impulse
+// solver visits contacts in this array's order, which Bullet leaves to the history of pair
+// creation and removal (and its broadphase's enlarged bounding boxes); in key order, a step's
+// result depends only on the manifolds' contents, which checkpoints hold (ContactCache), so a
+// restarted run continues bitwise.
+void SortManifolds(btDispatcher& dispatcher) {
+  const int n = dispatcher.getNumManifolds();
+  if (n < 2) return;
+  btPersistentManifold** array = dispatcher.getInternalManifoldPointer();
+  std::stable_sort(array, array + n, [](const btPersistentManifold* a, const btPersistentManifold* b) {
+    return ManifoldKey(*a) < ManifoldKey(*b);
+  });
+  for (int i = 0; i < n; ++i) array[i]->m_index1a = i;  // releaseManifold finds it there
+}
+
+// btDiscreteDynamicsWorld with the contact manifolds in key order when the constraints are
+// solved. With split islands off (set in RigidWorld's constructor) the solver takes that array
+// as it is; Bullet's island split would re-sort it with a non-stable sort.
+class SortedContactsWorld : public btDiscreteDynamicsWorld {
+ public:
+  using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
+  void solveConstraints(btContactSolverInfo& info) override {
+    SortManifolds(*getDispatcher());
+    btDiscreteDynamicsWorld::solveConstraints(info);
+  }
+};
+
+// ContactCache layout: a header (kContactCacheMagic, sizeof(btManifoldPoint)), then per manifold
+// a ManifoldRecord and its points as btManifoldPoint bytes.
+constexpr uint32_t kContactCacheMagic = 0x53434331;  // "SCC1"
+struct ManifoldRecord {
+  int32_t key0, key1, points, pad;
+  double breaking_threshold, processing_threshold;
+};
+
 struct RigidWorld::Impl {
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
   btDbvtBroadphase broadphase;
   btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &configuration};
+  SortedContactsWorld world{&dispatcher, &broadphase, &solver, &configuration};
 
   std::vector<std::unique_ptr<btTriangleMesh>> meshes;  // owned by us, referenced by shapes
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -172,6 +217,10 @@ RigidWorld::RigidWorld(const Vec3& gravity, const std::optional<GroundPlane>& gr
   // restitution only above 0.2 m/s approach speed, no solver-order randomisation (determinism).
   btContactSolverInfo& info = world.getSolverInfo();
   info.m_solverMode &= ~SOLVER_RANDMIZE_ORDER;
+  // One solver batch over every contact, in key order (SortedContactsWorld): bodies in separate
+  // groups do not interact, so this changes no result beyond round-off, and it keeps the order
+  // a function of the state.
+  world.getSimulationIslandManager()->setSplitIslands(false);
   if (ground) {
     SURGE_CHECK(ground->normal.norm() > 0, "ground plane normal is zero");
     const Vec3 n = ground->normal.normalized();
@@ -180,6 +229,7 @@ RigidWorld::RigidWorld(const Vec3& gravity, const std::optional<GroundPlane>& gr
     ci.m_friction = ground->friction;
     ci.m_restitution = 0;
     impl_->ground = std::make_unique<btRigidBody>(ci);
+    impl_->ground->setUserIndex(-1);
     world.addRigidBody(impl_->ground.get());
   }
 }
@@ -295,6 +345,7 @@ int RigidWorld::AddBody(const RigidBodyDesc& desc) {
     Require(desc.velocity.isZero() && desc.angular_velocity.isZero(), name,
             "a static body cannot have a velocity");
   }
+  body->setUserIndex(static_cast<int>(impl_->bodies.size()));  // ManifoldKey
   impl_->world.addRigidBody(body.get());
   impl_->shapes.push_back(std::move(shape));
   impl_->bodies.push_back(std::move(body));
@@ -354,6 +405,78 @@ void RigidWorld::SetState(int body, const BodyState& state) {
   b.setInterpolationAngularVelocity(ToBt(state.angular_velocity));
   b.updateInertiaTensor();
   impl_->world.updateSingleAabb(&b);
+}
+
+std::vector<uint8_t> RigidWorld::ContactCache() const {
+  btDispatcher& dispatcher = impl_->dispatcher;
+  SortManifolds(dispatcher);
+  std::vector<uint8_t> out;
+  auto put = [&out](const void* data, size_t size) {
+    const auto* b = static_cast<const uint8_t*>(data);
+    out.insert(out.end(), b, b + size);
+  };
+  const uint32_t header[2] = {kContactCacheMagic, uint32_t(sizeof(btManifoldPoint))};
+  put(header, sizeof header);
+  for (int i = 0; i < dispatcher.getNumManifolds(); ++i) {
+    const btPersistentManifold& m = *dispatcher.getManifoldByIndexInternal(i);
+    if (m.getNumContacts() == 0) continue;  // an empty manifold is the same as none
+    const auto [k0, k1] = ManifoldKey(m);
+    const ManifoldRecord r{k0, k1, m.getNumContacts(), 0, m.getContactBreakingThreshold(),
+                           m.getContactProcessingThreshold()};
+    put(&r, sizeof r);
+    for (int j = 0; j < m.getNumContacts(); ++j) {
+      btManifoldPoint pt = m.getContactPoint(j);
+      pt.m_userPersistentData = nullptr;  // a pointer means nothing in a file (and Surge sets none)
+      put(&pt, sizeof pt);
+    }
+  }
+  return out;
+}
+
+int RigidWorld::RestoreContactCache(const std::vector<uint8_t>& cache) {
+  uint32_t header[2] = {0, 0};
+  SURGE_CHECK(cache.size() >= sizeof header, "rigid contact cache: too short");
+  std::memcpy(header, cache.data(), sizeof header);
+  SURGE_CHECK(header[0] == kContactCacheMagic && header[1] == sizeof(btManifoldPoint),
+              "rigid contact cache: written by another build of Bullet");
+  // Pairs and (empty) manifolds for the restored poses, as the next step's collision detection
+  // would make them; then each manifold gets the points it held when the checkpoint was written.
+  btDispatcher& dispatcher = impl_->dispatcher;
+  impl_->world.performDiscreteCollisionDetection();
+  std::map<std::pair<int, int>, btPersistentManifold*> by_key;
+  for (int i = 0; i < dispatcher.getNumManifolds(); ++i) {
+    btPersistentManifold* m = dispatcher.getManifoldByIndexInternal(i);
+    m->clearManifold();
+    by_key[ManifoldKey(*m)] = m;
+  }
+  int missing = 0;
+  size_t at = sizeof header;
+  while (at < cache.size()) {
+    ManifoldRecord r{};
+    SURGE_CHECK(at + sizeof r <= cache.size(), "rigid contact cache: truncated");
+    std::memcpy(&r, cache.data() + at, sizeof r);
+    at += sizeof r;
+    SURGE_CHECK(r.points >= 0 && r.points <= MANIFOLD_CACHE_SIZE &&
+                    at + size_t(r.points) * sizeof(btManifoldPoint) <= cache.size(),
+                "rigid contact cache: bad manifold record");
+    const auto it = by_key.find({r.key0, r.key1});
+    if (it == by_key.end()) {
+      ++missing;  // the pair is not in contact range any more at the restored poses
+      at += size_t(r.points) * sizeof(btManifoldPoint);
+      continue;
+    }
+    btPersistentManifold& m = *it->second;
+    m.setContactBreakingThreshold(r.breaking_threshold);
+    m.setContactProcessingThreshold(r.processing_threshold);
+    for (int j = 0; j < r.points; ++j) {
+      btManifoldPoint pt;
+      std::memcpy(static_cast<void*>(&pt), cache.data() + at, sizeof pt);
+      at += sizeof pt;
+      m.addManifoldPoint(pt, /*isPredictive=*/true);  // appended in order: no validity check
+    }
+  }
+  SortManifolds(dispatcher);
+  return missing;
 }
 
 Real RigidWorld::Mass(int body) const {

@@ -2,6 +2,7 @@
 // a Bullet world behind our own types. Bullet is included only by rigid_world.cpp (pimpl).
 #pragma once
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -104,8 +105,18 @@ class RigidWorld {
 
   BodyState State(int body) const;
   // Sets pose and velocities (for checkpoints). State(b) afterwards returns `state` bitwise.
-  // Contact caches (Bullet's persistent manifolds) are not part of BodyState: see the docs.
+  // Contact caches (Bullet's persistent manifolds) are not part of BodyState: ContactCache.
   void SetState(int body, const BodyState& state);
+
+  // Bullet's persistent contact manifolds (contact points with their warm-start impulses), as
+  // bytes for a checkpoint. A world rebuilt with the same bodies, SetState to the same states
+  // and then RestoreContactCache continues bitwise as this one would (the contacts are solved in
+  // the order of their body indices, so no other history matters). The bytes are specific to
+  // this build of Bullet (checked on restore).
+  std::vector<uint8_t> ContactCache() const;
+  // Pre: every body added and SetState. Returns how many saved manifolds found no pair in contact
+  // range at the restored poses (0 when the states are those the cache was saved with).
+  int RestoreContactCache(const std::vector<uint8_t>& cache);
 
   Real Mass(int body) const;              // [kg]; 0 for static bodies
   Vec3 PrincipalInertia(int body) const;  // body-frame diagonal [kg m^2]; zero for static

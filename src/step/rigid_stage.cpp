@@ -6,10 +6,12 @@
 // fixed obstacles and the domain walls, and State::rigid takes the result for the next step.
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <type_traits>
 #include <variant>
 
 #include "contact/mesh_distance.h"
+#include "core/log.h"
 #include "step/stages.h"
 
 namespace surge {
@@ -120,6 +122,16 @@ void BuildRigidWorld(const Model& m, const State& s, Workspace& w) {
     b.angular_velocity = r.angular_velocity;
     b.velocity = r.velocity - r.angular_velocity.cross(r.position - b.position);
     world.SetState(h, k < w.rigid_restart.size() ? w.rigid_restart[k] : b);
+  }
+  // A restart: the contact points Bullet carried from step to step (warm-start impulses).
+  if (!w.rigid_restart_contacts.empty()) {
+    const int missing = world.RestoreContactCache(w.rigid_restart_contacts);
+    if (missing > 0) {
+      LogWarn("restart: " + std::to_string(missing) +
+              " rigid-body contact(s) of the checkpoint not restored (the bodies are out of "
+              "contact range); the run continues");
+    }
+    w.rigid_restart_contacts.clear();
   }
 }
 

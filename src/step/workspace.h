@@ -42,6 +42,9 @@ struct Workspace {
   // saved it, by body; used once, when the Bullet world is built, instead of re-deriving it from
   // State::rigid (which would round the centre of mass differently in the last bit).
   std::vector<RigidWorld::BodyState> rigid_restart;
+  // Bullet's contact manifolds at the checkpoint (RigidWorld::ContactCache), restored right
+  // after rigid_restart; empty when not restarting.
+  std::vector<uint8_t> rigid_restart_contacts;
 };
 
 }  // namespace surge

@@ -14,9 +14,8 @@
 #   2. A dynamic Bullet box falling through the air (3-D, 1600 particles) restarted from a
 #      checkpoint before it lands: bit for bit as well (Bullet's own body state is in the
 #      checkpoint). The same box resting on the floor (a Bullet contact with the floor slab)
-#      restarted during that contact: not bit for bit, because Bullet's persistent contact
-#      manifolds (warm-start impulses) are not in the checkpoint; measured largest relative
-#      difference of any float dataset 8.8e-12 (docs/robustness.md); checked below 1e-9.
+#      restarted during that contact: bit for bit too (Bullet's contact manifolds, with their
+#      warm-start impulses, are in the checkpoint and contacts are solved in body order).
 #   3. Refusals (exit 2): a rerun into an existing result without --force (the message names the
 #      file and offers --force and --restart), a checkpoint restarted with another scene (both
 #      files named) or other --set overrides or a changed mesh file (named), a file that is not a
@@ -61,7 +60,7 @@ bv_oldest=$(ls "$work"/bv_part/checkpoints/dam_bv_step_*.h5 | head -1)
 expect bv_restart 0 'completed' -- "$surge" run "$work/dam_bv.yaml" --restart "$bv_oldest" --progress quiet --threads 1
 expect bv_bitwise 0 'numeric datasets' -- $compare "$work/bv_full" "$work/bv_part" dam_bv
 
-# 2. A dynamic Bullet body: in flight (bit for bit) and resting on the floor (round-off).
+# 2. A dynamic Bullet body: in flight and resting on the floor, both bit for bit.
 cat > "$work/box.yaml" <<'YAML'
 name: box_push
 dimension: 3
@@ -87,8 +86,7 @@ for scene in box rest; do
 done
 # step 37 (t = 0.05 s): the box is 0.26 m up, in free fall, touching nothing.
 expect box_bitwise 0 'numeric datasets' -- $compare "$work/box_full" "$work/box_part" box_push
-expect rest_close 0 'numeric datasets' -- $compare "$work/rest_full" "$work/rest_part" box_push --tolerance 1e-9
-$compare "$work/rest_full" "$work/rest_part" box_push --tolerance 1e-9 | head -1
+expect rest_bitwise 0 'numeric datasets' -- $compare "$work/rest_full" "$work/rest_part" box_push
 
 # 3. Refusals and --force.
 newest=$(ls "$work"/full/checkpoints/dam_barrier_step_*.h5 | tail -1)

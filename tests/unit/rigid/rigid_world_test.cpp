@@ -239,6 +239,62 @@ TEST(RigidWorldTest, IdenticalWorldsStayBitwiseEqual) {
   EXPECT_LT(a.State(3).position.y(), 2.0);  // the hull fell: contacts were exercised
 }
 
+// A world rebuilt from a checkpoint during contacts (four bodies piling up on a tilted ground):
+// the body states plus ContactCache continue bitwise; the states alone do not (Bullet's
+// persistent contact points and their warm-start impulses are history).
+TEST(RigidWorldTest, RestoredWorldContinuesBitwiseDuringContacts) {
+  auto build = [](RigidWorld& w) {
+    w.AddBody(Box(Vec3(0.5, 0.2, 0.5), 2000, Vec3(0, 0.2, 0)));
+    RigidBodyDesc s;
+    s.shape = RigidSphere{0.3};
+    s.density = 2500;
+    s.position = Vec3(0.1, 1.0, 0.05);
+    w.AddBody(s);
+    RigidBodyDesc c;
+    c.shape = RigidCylinder{0.2, 0.4};
+    c.density = 1500;
+    c.position = Vec3(-0.3, 2.0, 0.2);
+    c.rotation = Rotation(0.7, Vec3(1, 0, 1));
+    w.AddBody(c);
+    RigidBodyDesc h;
+    h.shape = RigidConvexHull{{Vec3(-0.3, -0.2, -0.1), Vec3(0.4, -0.2, 0), Vec3(0, 0.3, -0.2),
+                               Vec3(0.1, 0, 0.4), Vec3(-0.2, 0.2, 0.3)}};
+    h.density = 2700;
+    h.position = Vec3(0.2, 3.0, -0.1);
+    w.AddBody(h);
+  };
+  const GroundPlane ground{Vec3::Zero(), Vec3(0.1, 1, 0), 0.5};
+  auto step = [](RigidWorld& w, int k) {
+    w.ApplyForce(0, Vec3(5 * std::sin(0.01 * k), 0, 0), Vec3(0, 0.3, 0));
+    w.Step(1e-3);
+  };
+  RigidWorld a(Vec3(0, -9.81, 0), ground);
+  build(a);
+  for (int k = 0; k < 1500; ++k) step(a, k);  // everything has landed: contacts persist
+  std::vector<RigidWorld::BodyState> states;
+  for (int body = 0; body < a.BodyCount(); ++body) states.push_back(a.State(body));
+  const std::vector<uint8_t> cache = a.ContactCache();
+  ASSERT_GT(cache.size(), 8u);
+  RigidWorld b(Vec3(0, -9.81, 0), ground), c(Vec3(0, -9.81, 0), ground);
+  build(b);
+  build(c);
+  for (int body = 0; body < a.BodyCount(); ++body) {
+    b.SetState(body, states[size_t(body)]);
+    c.SetState(body, states[size_t(body)]);
+  }
+  EXPECT_EQ(b.RestoreContactCache(cache), 0);
+  for (int k = 1500; k < 2000; ++k) {
+    for (RigidWorld* w : {&a, &b, &c}) step(*w, k);
+  }
+  bool c_differs = false;
+  for (int body = 0; body < a.BodyCount(); ++body) {
+    EXPECT_TRUE(BitwiseEqual(a.State(body), b.State(body))) << body;
+    c_differs = c_differs || !BitwiseEqual(a.State(body), c.State(body));
+  }
+  EXPECT_TRUE(c_differs) << "without the contact cache the restart should differ";
+  EXPECT_THROW(b.RestoreContactCache(std::vector<uint8_t>(3, 0)), std::exception);
+}
+
 // Mass and inertia from density against closed forms (solid cuboid, sphere, cylinder:
 // e.g. Goldstein, Classical Mechanics, 3rd ed., or any engineering table).
 TEST(RigidWorldTest, MassPropertiesMatchClosedForms) {
