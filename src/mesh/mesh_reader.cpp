@@ -114,6 +114,15 @@ void CheckPlyHeader(const std::string& path, const std::string& head) {
   while (std::getline(lines, text)) {
     ++line;
     if (!text.empty() && text.back() == '\r') text.pop_back();
+    // Printable ASCII, spaces and tabs only: assimp 5.2 splits header lines at '\n' alone, so
+    // "end_header\v..." (a vertical tab where the newline belongs) passed the word check below
+    // and its reader then looped forever (found by fuzz_mesh's mutation run).
+    for (const char c : text) {
+      if (c != '\t' && (c < 0x20 || c > 0x7e)) {
+        fail(line, "control or non-ASCII character (byte " +
+                       std::to_string(static_cast<unsigned char>(c)) + ") in the PLY header");
+      }
+    }
     std::istringstream words(text);
     std::vector<std::string> w;
     for (std::string word; words >> word;) w.push_back(word);
@@ -124,6 +133,7 @@ void CheckPlyHeader(const std::string& path, const std::string& head) {
     if (w.empty()) fail(line, "empty line in the PLY header");
     if (w[0] == "comment" || w[0] == "obj_info") continue;
     if (w[0] == "end_header") {
+      if (w.size() != 1) fail(line, "\"end_header\" must be alone on its line");
       if (!format) fail(line, "PLY header without a format line");
       return;
     }

@@ -122,6 +122,12 @@ TEST(ReadTriangleMeshTest, PlyWithoutEndHeaderThrowsNamingIt) {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nprmperty float y\n"
       "end_header\n0 0\n";
   ExpectRejected(WriteTemp("bad_header_line.ply", bad), "line 5: unknown PLY header line");
+  // ... and on "end_header" followed by a vertical tab instead of the newline (found by the
+  // mutation run of fuzz_mesh; corpus/mesh/regress_ply_end_header_vtab).
+  const std::string vtab =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\v0 0 0\n1 0 0\n0 1 0\n";
+  ExpectRejected(WriteTemp("vtab.ply", vtab), "line 7: control or non-ASCII character (byte 11)");
 }
 
 // A named pipe blocked the reader forever (a scene's mesh path is user input).
