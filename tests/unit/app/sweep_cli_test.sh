@@ -91,24 +91,24 @@ expect lock_released 0 '1 cases, 0 to run \(1 completed before\)' -- "$surge" sw
 cat > "$work/long.yaml" <<YAML
 base: $src/scenes/two_disks_2d.yaml
 parameters:
-  time.end: [10]
+  time.end: [4]
 set: {output.checkpoint_every: 0.2, output.every: 0.5}
 YAML
 "$surge" sweep "$work/long.yaml" --out "$work/long" >"$work/long_first.log" 2>&1 &
 spid=$!
-case_dir=$work/long/case_000_end=10
+case_dir=$work/long/case_000_end=4
 for _ in $(seq 100); do ls "$case_dir"/checkpoints/*_step_*.h5 >/dev/null 2>&1 && break; sleep 0.05; done
 kill -INT "$spid"; wait "$spid"; code=$?
-if [ "$code" -eq 130 ] && grep -q 'case_000_end=10: interrupted' "$work/long_first.log"; then ok resume_interrupted
+if [ "$code" -eq 130 ] && grep -q 'case_000_end=4: interrupted' "$work/long_first.log"; then ok resume_interrupted
 else bad "resume_interrupted: exit $code"; cat "$work/long_first.log"; fi
-expect resume_continues 0 'case_000_end=10: continuing from .*/checkpoints/two_disks_2d_step_[0-9]+\.h5' -- "$surge" sweep "$work/long.yaml" --out "$work/long"
+expect resume_continues 0 'case_000_end=4: continuing from .*/checkpoints/two_disks_2d_step_[0-9]+\.h5' -- "$surge" sweep "$work/long.yaml" --out "$work/long"
 grep -q 'completed' "$work/long/sweep.csv" && ok resume_completed || bad "resume_completed: $(cat "$work/long/sweep.csv")"
-"$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/long_ref" --progress quiet --set time.end=10 \
+"$surge" run "$src/scenes/two_disks_2d.yaml" --out "$work/long_ref" --progress quiet --set time.end=4 \
   --set output.checkpoint_every=0.2 --set output.every=0.5 >/dev/null 2>&1
 expect resume_bitwise 0 'numeric datasets' -- /usr/bin/python3 "$src/tests/regression/compare_results.py" "$work/long_ref" "$case_dir" two_disks_2d --ignore-attr @threads
 # --force starts it over.
 expect force_starts_over 0 '1 cases, 1 to run' -- "$surge" sweep "$work/long.yaml" --out "$work/long" --force
-grep -q 'continuing from' "$work/long/case_000_end=10/log.txt" && bad "force_starts_over_log: the log says it continued" || ok force_starts_over_log
+grep -q 'continuing from' "$work/long/case_000_end=4/log.txt" && bad "force_starts_over_log: the log says it continued" || ok force_starts_over_log
 
 # Rerun: every case is completed, nothing runs again (logs untouched).
 before=$(stat -c %Y.%N "$out"/case_*/log.txt "$out"/case_*/*.h5 | md5sum)
