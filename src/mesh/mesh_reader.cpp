@@ -7,8 +7,11 @@
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 #include <sstream>
@@ -95,11 +98,39 @@ struct Builder {
   }
 };
 
+// What a PLY header declares: the body's encoding and, per element, its count and properties.
+struct PlyProperty {
+  bool list = false;
+  std::string count_type;  // list only
+  std::string type;        // the scalar's, or the list items'
+};
+struct PlyElement {
+  uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+struct PlyLayout {
+  std::string format;     // ascii, binary_little_endian or binary_big_endian
+  size_t body = 0;        // byte offset of the body (after the end_header line)
+  int header_lines = 0;
+  std::vector<PlyElement> elements;
+};
+
+// Longest list (polygon) a PLY body may hold: assimp 5.2 reads a list's items one by one, so a
+// count of 2^31 (fuzz_mesh) kept it busy for hours.
+constexpr uint64_t kPlyMaxListLength = 65536;
+
+size_t PlyTypeSize(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "double" || t == "float64") return 8;
+  return 4;  // int, uint, float, int32, uint32, float32
+}
+
 // Throws naming the file and line unless `head` (the first kPlyHeaderBytes of the file) starts
 // with a well-formed PLY header (Bourke's PLY format): "ply", one "format <ascii|binary_*> 1.0",
 // then only "comment"/"obj_info" lines, "element <name> <count>" and "property <type> <name>" or
-// "property list <type> <type> <name>" lines, up to "end_header".
-void CheckPlyHeader(const std::string& path, const std::string& head) {
+// "property list <type> <type> <name>" lines, up to "end_header". Returns what it declares.
+PlyLayout CheckPlyHeader(const std::string& path, const std::string& head) {
   static const std::set<std::string> kTypes = {
       "char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8",
       "int16", "uint16", "int32", "uint32", "float32", "float64"};
@@ -111,6 +142,7 @@ void CheckPlyHeader(const std::string& path, const std::string& head) {
   std::string text;
   int line = 0;
   bool format = false;
+  PlyLayout layout;
   while (std::getline(lines, text)) {
     ++line;
     if (!text.empty() && text.back() == '\r') text.pop_back();
@@ -135,28 +167,133 @@ void CheckPlyHeader(const std::string& path, const std::string& head) {
     if (w[0] == "end_header") {
       if (w.size() != 1) fail(line, "\"end_header\" must be alone on its line");
       if (!format) fail(line, "PLY header without a format line");
-      return;
+      for (const PlyElement& e : layout.elements) {
+        if (e.count > 0 && e.properties.empty()) fail(line, "an element without properties");
+      }
+      layout.body = lines.tellg() < 0 ? head.size() : size_t(lines.tellg());
+      layout.header_lines = line;
+      return layout;
     }
     if (w[0] == "format") {
       if (format || w.size() != 3 || w[2] != "1.0" ||
           (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
         fail(line, "expected one \"format ascii|binary_little_endian|binary_big_endian 1.0\"");
       format = true;
+      layout.format = w[1];
     } else if (w[0] == "element") {
       if (w.size() != 3 || w[2].find_first_not_of("0123456789") != std::string::npos ||
           w[2].size() > 10)
         fail(line, "expected \"element <name> <count>\"");
+      layout.elements.push_back(PlyElement{std::stoull(w[2]), {}});
     } else if (w[0] == "property") {
       const bool list = w.size() == 5 && w[1] == "list" && kTypes.count(w[2]) && kTypes.count(w[3]);
       const bool scalar = w.size() == 3 && kTypes.count(w[1]);
       if (!list && !scalar)
         fail(line, "expected \"property <type> <name>\" or \"property list <type> <type> <name>\"");
+      if (layout.elements.empty()) fail(line, "a property before any element");
+      layout.elements.back().properties.push_back(
+          list ? PlyProperty{true, w[2], w[3]} : PlyProperty{false, "", w[1]});
     } else {
       fail(line, "unknown PLY header line \"" + w[0].substr(0, 40) + "\"");
     }
   }
   fail(line, "PLY header without an end_header line in its first " +
                  std::to_string(kPlyHeaderBytes) + " bytes");
+  return layout;  // not reached: fail throws
+}
+
+// Throws naming the file (and for ASCII the line) unless the body of a PLY file holds what its
+// header declares: every element instance, each scalar a finite number, each list count a
+// non-negative integer that fits its type and at most kPlyMaxListLength, followed by that many
+// numbers. assimp 5.2 loops forever or for hours on a token that is not a number ("inf") or on
+// a list count of 2^31 (fuzz_mesh mutation runs), so it only sees bodies that pass.
+void CheckPlyBody(const std::string& path, const std::string& file, const PlyLayout& layout) {
+  const auto fail = [&](const std::string& what) {
+    throw std::runtime_error("cannot read mesh file '" + path + "': " + what);
+  };
+  const auto max_of = [](const std::string& t) -> uint64_t {
+    const size_t size = PlyTypeSize(t);
+    const bool is_signed = t[0] != 'u';
+    return (uint64_t(1) << (8 * size - (is_signed ? 1 : 0))) - 1;
+  };
+  if (layout.format == "ascii") {
+    std::istringstream lines(file.substr(layout.body));
+    std::string text;
+    int line = layout.header_lines;
+    for (const PlyElement& e : layout.elements) {
+      for (uint64_t k = 0; k < e.count; ++k) {
+        ++line;
+        if (!std::getline(lines, text)) {
+          fail("line " + std::to_string(line) + ": the body ends before the " +
+               std::to_string(e.count) + " instances the header declares");
+        }
+        std::istringstream words(text);
+        std::string word;
+        const auto number = [&](const char* what) {
+          if (!(words >> word)) fail("line " + std::to_string(line) + ": missing " + what);
+          char* end = nullptr;
+          const double v = std::strtod(word.c_str(), &end);
+          if (end != word.c_str() + word.size() || !std::isfinite(v)) {
+            fail("line " + std::to_string(line) + ": \"" + word.substr(0, 40) +
+                 "\" is not a finite number");
+          }
+          return v;
+        };
+        for (const PlyProperty& p : e.properties) {
+          if (!p.list) {
+            number("value");
+            continue;
+          }
+          const double n = number("list count");
+          if (n < 0 || n != std::floor(n) || n > double(max_of(p.count_type)) ||
+              n > double(kPlyMaxListLength)) {
+            fail("line " + std::to_string(line) + ": list count " + word.substr(0, 40) +
+                 " is not an integer from 0 to " +
+                 std::to_string(std::min(max_of(p.count_type), kPlyMaxListLength)));
+          }
+          for (uint64_t i = 0; i < uint64_t(n); ++i) number("list item");
+        }
+        if (words >> word) {
+          fail("line " + std::to_string(line) + ": more values than the header declares");
+        }
+      }
+    }
+    return;
+  }
+  // Binary: walk the instances; list counts are read in the declared type and byte order.
+  const bool little = layout.format == "binary_little_endian";
+  size_t at = layout.body;
+  for (const PlyElement& e : layout.elements) {
+    for (uint64_t k = 0; k < e.count; ++k) {
+      for (const PlyProperty& p : e.properties) {
+        if (!p.list) {
+          at += PlyTypeSize(p.type);
+          continue;
+        }
+        const size_t size = PlyTypeSize(p.count_type);
+        if (at + size > file.size()) {
+          fail("the body ends before the " + std::to_string(e.count) +
+               " instances the header declares (" + std::to_string(file.size()) + " bytes)");
+        }
+        uint64_t raw = 0;
+        for (size_t b = 0; b < size; ++b) {
+          const uint64_t byte = static_cast<unsigned char>(file[at + (little ? b : size - 1 - b)]);
+          raw |= byte << (8 * b);
+        }
+        const bool negative = p.count_type[0] != 'u' && (raw >> (8 * size - 1)) != 0;
+        if (negative || raw > kPlyMaxListLength) {
+          fail("a list count at byte " + std::to_string(at) + " is " +
+               (negative ? std::string("negative") : std::to_string(raw)) + " (at most " +
+               std::to_string(kPlyMaxListLength) + ")");
+        }
+        at += size + raw * PlyTypeSize(p.type);
+      }
+      if (at > file.size()) {
+        fail("the body ends before the " + std::to_string(e.count) +
+             " instances the header declares (" + std::to_string(file.size()) + " bytes)");
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -179,7 +316,12 @@ TriangleMesh ReadTriangleMesh(const std::string& path) {
     head.resize(size_t(in.gcount()));
     std::string ext = std::filesystem::path(path).extension().string();
     for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (ext == ".ply" || head.rfind("ply", 0) == 0) CheckPlyHeader(path, head);
+    if (ext == ".ply" || head.rfind("ply", 0) == 0) {
+      const PlyLayout layout = CheckPlyHeader(path, head);
+      std::string file = std::move(head);  // and the rest of it: the body is checked too
+      file.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      CheckPlyBody(path, file, layout);
+    }
   }
   Assimp::Importer importer;
   // No aiProcess_PreTransformVertices: it joins meshes that share a material, which would merge

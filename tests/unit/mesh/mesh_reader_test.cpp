@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -128,6 +129,61 @@ TEST(ReadTriangleMeshTest, PlyWithoutEndHeaderThrowsNamingIt) {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nend_header\v0 0 0\n1 0 0\n0 1 0\n";
   ExpectRejected(WriteTemp("vtab.ply", vtab), "line 7: control or non-ASCII character (byte 11)");
+}
+
+// A cube as PLY, ASCII and binary: read, and the body checks that keep assimp 5.2 from looping
+// (found by fuzz_mesh's mutation runs: a list count of 2^31, an "inf" token) refuse bad bodies
+// naming the line or byte.
+const char kPlyHeader[] =
+    "element vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
+const float kCubeVertices[8][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {0, 1, 1},
+                                   {1, 0, 0}, {1, 0, 1}, {1, 1, 0}, {1, 1, 1}};
+const int kCubeFaces[12][3] = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5}, {0, 4, 5}, {0, 5, 1},
+                               {2, 3, 7}, {2, 7, 6}, {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+
+std::string AsciiCubePly(const std::string& first_face = "3 0 1 3") {
+  std::string s = std::string("ply\nformat ascii 1.0\n") + kPlyHeader;
+  for (const auto& v : kCubeVertices)
+    s += std::to_string(int(v[0])) + " " + std::to_string(int(v[1])) + " " + std::to_string(int(v[2])) + "\n";
+  s += first_face + "\n";
+  for (int f = 1; f < 12; ++f)
+    s += "3 " + std::to_string(kCubeFaces[f][0]) + " " + std::to_string(kCubeFaces[f][1]) + " " +
+         std::to_string(kCubeFaces[f][2]) + "\n";
+  return s;
+}
+
+std::string BinaryCubePly(uint32_t first_count = 3) {
+  std::string s = std::string("ply\nformat binary_little_endian 1.0\n") + kPlyHeader;
+  const auto put = [&s](const void* p, size_t n) { s.append(static_cast<const char*>(p), n); };
+  for (const auto& v : kCubeVertices) put(v, sizeof v);
+  for (int f = 0; f < 12; ++f) {
+    const unsigned char n = f == 0 ? static_cast<unsigned char>(first_count) : 3;
+    put(&n, 1);
+    put(kCubeFaces[f], sizeof kCubeFaces[f]);
+  }
+  return s;
+}
+
+TEST(ReadTriangleMeshTest, PlyAsciiAndBinaryBodiesAreCheckedBeforeAssimpReadsThem) {
+  EXPECT_EQ(ReadTriangleMesh(WriteTemp("cube_ascii.ply", AsciiCubePly())).triangles.size(), 12u);
+  EXPECT_EQ(ReadTriangleMesh(WriteTemp("cube_binary.ply", BinaryCubePly())).triangles.size(), 12u);
+  ExpectRejected(WriteTemp("huge_list.ply", AsciiCubePly("2147483648 0 1 3")),
+                 "line 18: list count 2147483648 is not an integer from 0 to 255");
+  std::string inf = AsciiCubePly();
+  inf.replace(inf.find("end_header\n0 0 0") + 11, 1, "inf");
+  ExpectRejected(WriteTemp("inf_token.ply", inf), "line 10: \"inf\" is not a finite number");
+  ExpectRejected(WriteTemp("extra_value.ply", AsciiCubePly("3 0 1 3 7")),
+                 "line 18: more values than the header declares");
+  std::string cut = AsciiCubePly();
+  cut.erase(cut.rfind("3 1 7 3\n"));  // the last face line
+  ExpectRejected(WriteTemp("cut_ascii.ply", cut), "line 29: the body ends before the 12 instances");
+  cut.resize(cut.size() - 3);  // and half of the one before
+  ExpectRejected(WriteTemp("cut_ascii2.ply", cut), "line 28: missing list item");
+  std::string short_binary = BinaryCubePly();
+  short_binary.resize(short_binary.size() - 5);
+  ExpectRejected(WriteTemp("cut_binary.ply", short_binary), "the body ends before the 12 instances");
+  ExpectRejected(WriteTemp("long_list_binary.ply", BinaryCubePly(200)), "the body ends before");
 }
 
 // A named pipe blocked the reader forever (a scene's mesh path is user input).
