@@ -200,30 +200,34 @@ TEST(RigidWorldTest, RestoredWorldContinuesBitwiseInFreeFlight) {
   EXPECT_GT((a.State(ia).angular_velocity - Vec3(3, 0.5, -1)).norm(), 1e-3);  // it did tumble
 }
 
+// A box, a sphere, a tilted cylinder and a spinning hull (angular velocity `hull_spin`) above
+// one another: they fall on the ground and on each other.
+void AddPile(RigidWorld& w, const Vec3& hull_spin) {
+  w.AddBody(Box(Vec3(0.5, 0.2, 0.5), 2000, Vec3(0, 0.2, 0)));
+  RigidBodyDesc s;
+  s.shape = RigidSphere{0.3};
+  s.density = 2500;
+  s.position = Vec3(0.1, 1.0, 0.05);
+  w.AddBody(s);
+  RigidBodyDesc c;
+  c.shape = RigidCylinder{0.2, 0.4};
+  c.density = 1500;
+  c.position = Vec3(-0.3, 2.0, 0.2);
+  c.rotation = Rotation(0.7, Vec3(1, 0, 1));
+  w.AddBody(c);
+  RigidBodyDesc h;
+  h.shape = RigidConvexHull{{Vec3(-0.3, -0.2, -0.1), Vec3(0.4, -0.2, 0), Vec3(0, 0.3, -0.2),
+                             Vec3(0.1, 0, 0.4), Vec3(-0.2, 0.2, 0.3)}};
+  h.density = 2700;
+  h.position = Vec3(0.2, 3.0, -0.1);
+  h.angular_velocity = hull_spin;
+  w.AddBody(h);
+}
+
 // Same calls in the same order -> bitwise the same states, with contacts (boxes, a sphere, a hull
 // and a cylinder falling on the ground and on each other).
 TEST(RigidWorldTest, IdenticalWorldsStayBitwiseEqual) {
-  auto build = [](RigidWorld& w) {
-    w.AddBody(Box(Vec3(0.5, 0.2, 0.5), 2000, Vec3(0, 0.2, 0)));
-    RigidBodyDesc s;
-    s.shape = RigidSphere{0.3};
-    s.density = 2500;
-    s.position = Vec3(0.1, 1.0, 0.05);
-    w.AddBody(s);
-    RigidBodyDesc c;
-    c.shape = RigidCylinder{0.2, 0.4};
-    c.density = 1500;
-    c.position = Vec3(-0.3, 2.0, 0.2);
-    c.rotation = Rotation(0.7, Vec3(1, 0, 1));
-    w.AddBody(c);
-    RigidBodyDesc h;
-    h.shape = RigidConvexHull{{Vec3(-0.3, -0.2, -0.1), Vec3(0.4, -0.2, 0), Vec3(0, 0.3, -0.2),
-                               Vec3(0.1, 0, 0.4), Vec3(-0.2, 0.2, 0.3)}};
-    h.density = 2700;
-    h.position = Vec3(0.2, 3.0, -0.1);
-    h.angular_velocity = Vec3(1, 2, 3);
-    w.AddBody(h);
-  };
+  auto build = [](RigidWorld& w) { AddPile(w, Vec3(1, 2, 3)); };
   RigidWorld a(Vec3(0, -9.81, 0), GroundPlane{Vec3::Zero(), Vec3(0.1, 1, 0), 0.5});
   RigidWorld b(Vec3(0, -9.81, 0), GroundPlane{Vec3::Zero(), Vec3(0.1, 1, 0), 0.5});
   build(a);
@@ -243,26 +247,7 @@ TEST(RigidWorldTest, IdenticalWorldsStayBitwiseEqual) {
 // the body states plus ContactCache continue bitwise; the states alone do not (Bullet's
 // persistent contact points and their warm-start impulses are history).
 TEST(RigidWorldTest, RestoredWorldContinuesBitwiseDuringContacts) {
-  auto build = [](RigidWorld& w) {
-    w.AddBody(Box(Vec3(0.5, 0.2, 0.5), 2000, Vec3(0, 0.2, 0)));
-    RigidBodyDesc s;
-    s.shape = RigidSphere{0.3};
-    s.density = 2500;
-    s.position = Vec3(0.1, 1.0, 0.05);
-    w.AddBody(s);
-    RigidBodyDesc c;
-    c.shape = RigidCylinder{0.2, 0.4};
-    c.density = 1500;
-    c.position = Vec3(-0.3, 2.0, 0.2);
-    c.rotation = Rotation(0.7, Vec3(1, 0, 1));
-    w.AddBody(c);
-    RigidBodyDesc h;
-    h.shape = RigidConvexHull{{Vec3(-0.3, -0.2, -0.1), Vec3(0.4, -0.2, 0), Vec3(0, 0.3, -0.2),
-                               Vec3(0.1, 0, 0.4), Vec3(-0.2, 0.2, 0.3)}};
-    h.density = 2700;
-    h.position = Vec3(0.2, 3.0, -0.1);
-    w.AddBody(h);
-  };
+  auto build = [](RigidWorld& w) { AddPile(w, Vec3::Zero()); };
   const GroundPlane ground{Vec3::Zero(), Vec3(0.1, 1, 0), 0.5};
   auto step = [](RigidWorld& w, int k) {
     w.ApplyForce(0, Vec3(5 * std::sin(0.01 * k), 0, 0), Vec3(0, 0.3, 0));
