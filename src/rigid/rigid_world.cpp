@@ -412,8 +412,9 @@ std::vector<uint8_t> RigidWorld::ContactCache() const {
   SortManifolds(dispatcher);
   std::vector<uint8_t> out;
   auto put = [&out](const void* data, size_t size) {
-    const auto* b = static_cast<const uint8_t*>(data);
-    out.insert(out.end(), b, b + size);
+    const size_t at = out.size();
+    out.resize(at + size);
+    std::memcpy(out.data() + at, data, size);
   };
   const uint32_t header[2] = {kContactCacheMagic, uint32_t(sizeof(btManifoldPoint))};
   put(header, sizeof header);
