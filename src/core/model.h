@@ -36,13 +36,19 @@ struct Wall {
 
 enum class ExitPolicy { kRemove, kStop };
 
-// Volumetric anti-locking of a material (Mast 2013 ch. 4, AS1 control volumes; src/stabilize).
-enum class AntiLockingMethod { kNone, kNode, kCell };
+// Anti-locking of a material (Mast 2013 ch. 4; src/stabilize): the control volumes (4.25)-(4.35).
+// kHybrid: the trace from node-based control volumes, the deviator from cell-based ones (§4.4.3).
+enum class AntiLockingMethod { kNone, kNode, kCell, kHybrid };
+// What is approximated (seed (4.14)-(4.23)): kVolumetric = AS1, the trace only, constant over the
+// control volume; kVolumetricDeviatoric = AS2, the full tensor: trace, e11, e22 linear in the
+// control volume, the shears constant; kConstantVolumetric = AS3CV, AS2 with a constant trace.
+enum class AntiLockingApproach { kVolumetric, kVolumetricDeviatoric, kConstantVolumetric };
 // What is projected: the trace of the total trial (elastic) Hencky strain, ln J^tr (seed §4.4.4),
 // or only that of the step's increment, ln det f (F-bar on the increment).
 enum class AntiLockingStrain { kTotal, kIncrement };
 struct AntiLocking {
   AntiLockingMethod method = AntiLockingMethod::kNone;
+  AntiLockingApproach approach = AntiLockingApproach::kVolumetric;
   AntiLockingStrain strain = AntiLockingStrain::kTotal;
   // Also project the mean stress after the stress update (seed Table 4.1 steps 6-7, optional).
   bool stress = false;

@@ -55,7 +55,12 @@ constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
 constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockingMethod::kNone},
                                                              {"node", AntiLockingMethod::kNode},
-                                                             {"cell", AntiLockingMethod::kCell}};
+                                                             {"cell", AntiLockingMethod::kCell},
+                                                             {"hybrid", AntiLockingMethod::kHybrid}};
+constexpr EnumName<AntiLockingApproach> kAntiLockingApproachNames[] = {
+    {"volumetric", AntiLockingApproach::kVolumetric},
+    {"volumetric_deviatoric", AntiLockingApproach::kVolumetricDeviatoric},
+    {"constant_volumetric", AntiLockingApproach::kConstantVolumetric}};
 constexpr EnumName<AntiLockingStrain> kAntiLockingStrainNames[] = {
     {"total", AntiLockingStrain::kTotal}, {"increment", AntiLockingStrain::kIncrement}};
 constexpr EnumName<ForceComponent> kComponentNames[] = {{"x", ForceComponent::kX},
@@ -569,11 +574,35 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
     m.values[d.key] = static_cast<Real>(it - choices.begin());
   }
   if (const YAML::Node al = n["antilocking"]) {
-    // antilocking: {method: none | node | cell, approach: volumetric, strain: total | increment,
-    // stress: false | true} (docs/antilocking.md).
+    // antilocking: {method: none | node | cell | hybrid, approach: volumetric |
+    // volumetric_deviatoric | constant_volumetric, strain: total | increment, stress: false | true}
+    // (docs/antilocking.md).
     const std::string ap = Child(path, "antilocking");
     ExpectMap(al, ap, {"method", "approach", "strain", "stress"});
     m.antilocking = Enum(Need(al, ap, "method"), Child(ap, "method"), kAntiLockingNames);
+    const bool hybrid = *m.antilocking == AntiLockingMethod::kHybrid;
+    // Hybrid is node-based volumetric plus cell-based deviatoric (seed (4.33)-(4.35)): a full
+    // tensor approximation by definition.
+    m.antilocking_approach =
+        hybrid ? AntiLockingApproach::kVolumetricDeviatoric : AntiLockingApproach::kVolumetric;
+    if (const YAML::Node a = al["approach"]) {
+      m.antilocking_approach = Enum(a, Child(ap, "approach"), kAntiLockingApproachNames);
+      const bool full = m.antilocking_approach != AntiLockingApproach::kVolumetric;
+      if (hybrid && m.antilocking_approach != AntiLockingApproach::kVolumetricDeviatoric) {
+        Fail(a, Child(ap, "approach"),
+             "method hybrid takes the trace from node-based and the deviator from cell-based "
+             "control volumes (seed (4.33)-(4.35)): approach volumetric_deviatoric (or leave it out)");
+      }
+      if (full && *m.antilocking == AntiLockingMethod::kNode) {
+        Fail(a, Child(ap, "approach"),
+             "the node-based full-tensor approximation is not implemented: use method cell or "
+             "hybrid with approach " + a.Scalar() + ", or method node with approach volumetric");
+      }
+      if (full && *m.antilocking == AntiLockingMethod::kNone) {
+        Fail(a, Child(ap, "approach"), "approach " + a.Scalar() +
+                                           " needs a control volume: method cell or hybrid");
+      }
+    }
     if (al["strain"]) {
       m.antilocking_strain = Enum(al["strain"], Child(ap, "strain"), kAntiLockingStrainNames);
     }
@@ -582,12 +611,10 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
       if (m.antilocking_stress && *m.antilocking == AntiLockingMethod::kNone) {
         Fail(st, Child(ap, "stress"), "stress averaging needs a control volume: method node or cell");
       }
-    }
-    if (const YAML::Node a = al["approach"]) {
-      if (!a.IsScalar() || a.Scalar() != "volumetric") {
-        Fail(a, Child(ap, "approach"),
-             "expected volumetric, got " + Describe(a) +
-                 " (the volumetric-deviatoric approach is not implemented yet, issue #4)");
+      if (m.antilocking_stress && m.antilocking_approach != AntiLockingApproach::kVolumetric) {
+        Fail(st, Child(ap, "stress"),
+             "stress averaging is implemented for the volumetric approach only (method node or "
+             "cell, approach volumetric)");
       }
     }
   }
@@ -1475,6 +1502,7 @@ SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
 AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
   AntiLocking a;
   a.strain = m.antilocking_strain;
+  a.approach = m.antilocking_approach;
   a.stress = m.antilocking_stress;
   if (m.antilocking) {
     a.method = *m.antilocking;
@@ -1646,7 +1674,8 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     const AntiLocking al = ResolvedAntiLocking(m);
     e << YAML::Key << "antilocking" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
       << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
-      << "approach" << YAML::Value << "volumetric" << YAML::Key << "strain" << YAML::Value
+      << "approach" << YAML::Value << NameOf(kAntiLockingApproachNames, al.approach)
+      << YAML::Key << "strain" << YAML::Value
       << NameOf(kAntiLockingStrainNames, al.strain);
     if (al.stress) e << YAML::Key << "stress" << YAML::Value << true;  // only when on
     e << YAML::EndMap;

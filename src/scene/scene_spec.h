@@ -89,6 +89,7 @@ struct MaterialSpec {
   // of the material's class, ResolvedAntiLocking().
   std::optional<AntiLockingMethod> antilocking;
   AntiLockingStrain antilocking_strain = AntiLockingStrain::kTotal;
+  AntiLockingApproach antilocking_approach = AntiLockingApproach::kVolumetric;
   bool antilocking_stress = false;  // `antilocking: {stress: true}`: Table 4.1 steps 6-7
   // `bulk_viscosity: {quadratic, linear}` (docs/antilocking.md); disabled when not written.
   BulkViscosity bulk_viscosity;

@@ -5,12 +5,16 @@
 // et al. 1996, IJSS 33:3277). Scatter as in particle_to_grid.cpp.
 #include "stabilize/antilocking.h"
 
+#include <array>
 #include <cmath>
+#include <limits>
 #include <type_traits>
 #include <variant>
 
 #include "core/check.h"
 #include "core/parallel.h"
+#include "materials/hencky.h"
+#include "materials/symmetric_eigen.h"
 #include "transfer/dispatch.h"
 #include "transfer/stencil_loop.h"
 
@@ -168,6 +172,279 @@ void DispatchProjection(const Model& model, AntiLockingMethod method, const Body
   });
 }
 
+// ---- Full-tensor approximations: AS2, AS3CV and the hybrid control volume (seed (4.17)-(4.23),
+// (4.33)-(4.35)) in the finite-deformation form of §4.4.4-4.4.5. ----
+
+// Filtered components (seed filter M of (4.17)-(4.22)): the trace and the normal deviator
+// components, which vary linearly over a control volume (S rows [1, xi, eta, zeta]), then the
+// shears, constant. 3-D: {tr eps, e11, e22 | eps12, eps13, eps23}, e33 = -e11 - e22. 2-D (plane
+// strain, the in-plane block): {eps11 + eps22, (eps11 - eps22)/2 | eps12}.
+template <int kDim>
+struct Filtered {
+  static constexpr int kLinear = kDim == 3 ? 3 : 2;   // linear components, the trace first
+  static constexpr int kConst = kDim == 3 ? 3 : 1;    // constant components (shears)
+  static constexpr int kSym = kDim * (kDim + 1) / 2;  // entries of sum w xi xi^T
+  // Moment sums of one cell: sum w, sum w xi, sum w xi xi^T, per linear component sum w q and
+  // sum w xi q, per constant component sum w q (the normal equations of (4.25)_1, as particle
+  // sums (4.24); w = m_p).
+  static constexpr int kMoments = 1 + kDim + kSym + kLinear * (1 + kDim) + kConst;
+  std::array<Real, kLinear + kConst> q;
+
+  static Filtered Of(const Mat3& e) {
+    Filtered r;
+    if constexpr (kDim == 3) {
+      const Real tr = e.trace();
+      r.q = {tr, e(0, 0) - tr / 3, e(1, 1) - tr / 3, e(0, 1), e(0, 2), e(1, 2)};
+    } else {
+      r.q = {e(0, 0) + e(1, 1), (e(0, 0) - e(1, 1)) / 2, e(0, 1)};
+    }
+    return r;
+  }
+  // The reconstruction M* (4.19): the tensor of these components; in 2-D the out-of-plane
+  // entries are the particle's own (`own`), the in-plane/out-of-plane shears zero.
+  Mat3 Tensor(const Mat3& own) const {
+    Mat3 e;
+    if constexpr (kDim == 3) {
+      const Real t = q[0] / 3;
+      e << t + q[1], q[3], q[4],  //
+          q[3], t + q[2], q[5],   //
+          q[4], q[5], t - q[1] - q[2];
+    } else {
+      e.setZero();
+      e(0, 0) = q[0] / 2 + q[1];
+      e(1, 1) = q[0] / 2 - q[1];
+      e(0, 1) = e(1, 0) = q[2];
+      e(2, 2) = own(2, 2);
+    }
+    return e;
+  }
+};
+
+// Position of x in its cell, xi = x/dx - floor(x/dx) - 1/2, in cell units (origin at the cell
+// centre; the fitted field does not depend on the origin, spec §3.3 [DERIVED]).
+template <int kDim>
+Eigen::Matrix<Real, kDim, 1> CellXi(const Vec3& x, Real inv_dx, Vec3i& cell) {
+  Eigen::Matrix<Real, kDim, 1> xi;
+  cell.setZero();
+  for (int d = 0; d < kDim; ++d) {
+    const Real u = x[d] * inv_dx;
+    cell[d] = int(std::floor(u));
+    xi[d] = u - cell[d] - 0.5;
+  }
+  return xi;
+}
+
+// Weighted least-squares fit over one cell, from its moment sums `a` (Filtered::kMoments), at the
+// particle position xi: the linear components a + b.(xi - c) with the mass centroid c as origin
+// (spec §3.3 [REC]), the normal equations in centred form C b = sum w (xi - c) q / sum w,
+// C = sum w (xi - c)(xi - c)^T / sum w; the constant components the weighted mean. When C is
+// singular (the cell's particles on a plane or a line, a body entering a cell) every component
+// falls back to the constant approximation for this cell and step (seed §4.4.6).
+template <int kDim>
+Filtered<kDim> CellFit(const Real* a, const Eigen::Matrix<Real, kDim, 1>& xi, bool* linear_out) {
+  using F = Filtered<kDim>;
+  using VecD = Eigen::Matrix<Real, kDim, 1>;
+  using MatD = Eigen::Matrix<Real, kDim, kDim>;
+  const Real s0 = a[0];
+  VecD c;
+  for (int d = 0; d < kDim; ++d) c[d] = a[1 + d] / s0;
+  MatD C;
+  int k = 1 + kDim;
+  for (int d = 0; d < kDim; ++d)
+    for (int e = d; e < kDim; ++e, ++k) C(d, e) = C(e, d) = a[k] / s0 - c[d] * c[e];
+  const Real tr = C.trace();
+  // Relative singularity test: det C against (tr C / dim)^dim, 1 for an isotropic spread.
+  const bool linear = tr > 0 && C.determinant() > 1e-10 * std::pow(tr / kDim, kDim);
+  if (linear_out) *linear_out = linear;
+  const MatD Cinv = linear ? MatD(C.inverse()) : MatD::Zero();
+  F out;
+  for (int l = 0; l < F::kLinear; ++l, k += 1 + kDim) {
+    const Real mean = a[k] / s0;
+    out.q[l] = mean;
+    if (linear) {
+      VecD cov;
+      for (int d = 0; d < kDim; ++d) cov[d] = a[k + 1 + d] / s0 - c[d] * mean;
+      out.q[l] += (Cinv * cov).dot(xi - c);
+    }
+  }
+  for (int l = 0; l < F::kConst; ++l, ++k) out.q[F::kLinear + l] = a[k] / s0;
+  return out;
+}
+
+// g(A) = Q diag(g(lambda)) Q^T of the symmetric in-plane 2x2 block of A, by one exact rotation.
+template <class G>
+Eigen::Matrix2d SymmetricFunction2(const Mat3& A, const G& g) {
+  const Real a = A(0, 0), d = A(1, 1), c = 0.5 * (A(0, 1) + A(1, 0));
+  const Real phi = 0.5 * std::atan2(2 * c, a - d), cs = std::cos(phi), sn = std::sin(phi);
+  const Real l1 = a * cs * cs + 2 * c * sn * cs + d * sn * sn;
+  const Real l2 = a * sn * sn - 2 * c * sn * cs + d * cs * cs;
+  Eigen::Matrix2d Q;
+  Q << cs, -sn, sn, cs;
+  return Q * Eigen::Vector2d(g(l1), g(l2)).asDiagonal() * Q.transpose();
+}
+
+// The trial (elastic) Hencky strain eps = 1/2 ln b^tr, b^tr = f b_ref f^T (seed (4.36)-(4.38)),
+// and the inverse stretch (b^tr)^(-1/2). In 2-D the in-plane block and the 33 entry separately
+// (plane strain: b^tr is block diagonal). False when b^tr is not positive definite.
+template <int kDim>
+bool TrialLogStrain(const Mat3& f, const Mat3& b_ref, Mat3& eps, Mat3& inv_stretch) {
+  const Mat3 b = f * b_ref * f.transpose();
+  if constexpr (kDim == 3) {
+    Vec3 lam;
+    Mat3 Q;
+    SymmetricEigen(b, lam, Q);
+    if (!(lam.minCoeff() > 0) || !std::isfinite(lam.maxCoeff())) return false;
+    eps = FromPrincipal(Q, 0.5 * lam.array().log().matrix());
+    inv_stretch = FromPrincipal(Q, lam.array().rsqrt().matrix());
+  } else {
+    const Real det = b(0, 0) * b(1, 1) - b(0, 1) * b(1, 0);
+    if (!(det > 0) || !(b(0, 0) > 0) || !(b(2, 2) > 0) || !std::isfinite(det)) return false;
+    eps.setZero();
+    inv_stretch.setZero();
+    eps.topLeftCorner<2, 2>() = SymmetricFunction2(b, [](Real l) { return 0.5 * std::log(l); });
+    inv_stretch.topLeftCorner<2, 2>() = SymmetricFunction2(b, [](Real l) { return 1 / std::sqrt(l); });
+    eps(2, 2) = 0.5 * std::log(b(2, 2));
+    inv_stretch(2, 2) = 1 / std::sqrt(b(2, 2));
+  }
+  return true;
+}
+
+// The increment that takes b_ref to exp(2 eps_h) (seed (4.40)): f-bar = exp(eps_h) (b^tr)^(-1/2) f,
+// so f-bar b_ref f-bar^T = exp(eps_h) (b^tr)^(-1/2) b^tr (b^tr)^(-1/2) exp(eps_h) = exp(2 eps_h).
+// In 2-D the in-plane block only; f's out-of-plane entries are kept (f33 = 1 in plane strain).
+template <int kDim>
+Mat3 ProjectedIncrement(const Mat3& f, const Mat3& eps_h, const Mat3& inv_stretch) {
+  if constexpr (kDim == 3) {
+    Vec3 e;
+    Mat3 Q;
+    SymmetricEigen(eps_h, e, Q);
+    return FromPrincipal(Q, e.array().exp().matrix()) * inv_stretch * f;
+  } else {
+    Mat3 out = f;
+    const Eigen::Matrix2d v = SymmetricFunction2(eps_h, [](Real l) { return std::exp(l); });
+    out.topLeftCorner<2, 2>() = v * inv_stretch.topLeftCorner<2, 2>() * f.topLeftCorner<2, 2>();
+    return out;
+  }
+}
+
+// Cell moment sums of one block's particles of [begin, end) into the grid slots of the cells'
+// lower-corner nodes (scratch.moments, stride kMoments), through the padded block buffer as in
+// ScatterBlock (fixed order: particle order, then colour order).
+template <int kDim, class K>
+void ScatterCellMoments(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                        size_t begin, size_t end, const SparseGrid& grid, size_t blk,
+                        std::vector<Real>& buf, AntiLockingScratch& s) {
+  using Pad = BlockPad<kDim, K>;
+  using F = Filtered<kDim>;
+  constexpr int M = F::kMoments;
+  buf.assign(size_t(Pad::kSize) * M, 0.0);
+  const Vec3i origin = grid.block_origin[blk];
+  bool any = false;
+  for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
+    const uint32_t p = grid.sorted[k];
+    if (p < begin || p >= end || !s.trial_ok[p]) continue;
+    any = true;
+    Vec3i cell;
+    const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
+    const Vec3i lc = cell - origin;
+    Real* a = &buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M];
+    const F f = F::Of(s.trial_eps[p]);
+    const Real m = P.mass[p];
+    int j = 0;
+    a[j++] += m;
+    for (int d = 0; d < kDim; ++d) a[j++] += m * xi[d];
+    for (int d = 0; d < kDim; ++d)
+      for (int e = d; e < kDim; ++e) a[j++] += m * xi[d] * xi[e];
+    for (int l = 0; l < F::kLinear; ++l) {
+      a[j++] += m * f.q[l];
+      for (int d = 0; d < kDim; ++d) a[j++] += m * xi[d] * f.q[l];
+    }
+    for (int l = 0; l < F::kConst; ++l) a[j++] += m * f.q[F::kLinear + l];
+  }
+  if (!any) return;
+  for (int a = 0; a < Pad::E; ++a)
+    for (int b = 0; b < Pad::E; ++b)
+      for (int c = 0; c < Pad::Ez; ++c) {
+        const Real* n = &buf[size_t(Pad::Index(a, b, c)) * M];
+        if (n[0] == 0) continue;
+        const long g = PaddedToGrid(grid, blk, a, b, c);
+        SURGE_ASSERT(g >= 0);
+        if (g < 0) continue;
+        Real* out = &s.moments[size_t(g) * M];
+        for (int j = 0; j < M; ++j) out[j] += n[j];
+      }
+}
+
+// AS2 / AS3CV on cell-based control volumes, or the hybrid (trace from node-based AS1, deviator
+// from cell-based AS2), on the trial strain of one material group; replaces L_p by
+// (f-bar_p - I)/dt (seed Table 4.1 steps 2-4, (4.25)-(4.27), (4.33)-(4.34), (4.40)).
+template <int kDim, class K>
+void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                       size_t begin, size_t end, const SparseGrid& grid, const Mode& mode,
+                       const AntiLocking& al, AntiLockingScratch& s, std::vector<Mat3>& L) {
+  using F = Filtered<kDim>;
+  constexpr int M = F::kMoments;
+  const size_t n = P.size();
+  s.trial_eps.resize(n);
+  s.inv_stretch.resize(n);
+  s.trial_ok.resize(n);
+  // Step 2: the trial (elastic) strain of every particle of the group.
+  ParallelFor(end - begin, 256, [&](size_t i) {
+    const size_t p = begin + i;
+    const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
+    const Mat3 b_ref = mode.increment       ? Mat3::Identity()
+                       : mode.elastoplastic ? P.elastic_b[p]
+                                            : Mat3(P.F[p] * P.F[p].transpose());
+    s.trial_ok[p] = TrialLogStrain<kDim>(f, b_ref, s.trial_eps[p], s.inv_stretch[p]);
+  });
+  // Hybrid, volumetric part: node-based AS1 of theta = tr eps (4.29)-(4.32), (4.34)_1.
+  const bool hybrid = al.method == AntiLockingMethod::kHybrid;
+  if (hybrid) {
+    s.theta_bar.assign(n, std::numeric_limits<Real>::quiet_NaN());
+    const auto theta = [&](size_t p) {
+      return s.trial_ok[p] ? F::Of(s.trial_eps[p]).q[0] : std::numeric_limits<Real>::quiet_NaN();
+    };
+    const auto keep = [&](size_t p, Real theta_bar) { s.theta_bar[p] = theta_bar; };
+    Project<kDim, K, true>(ctx, P, x_n, begin, end, grid, s, theta, keep);
+  }
+  // Cell moments (4.25)_1 with H_c = sum S^T S m, colour-phased as every scatter.
+  s.moments.assign(grid.block_count() * kBlockNodes * size_t(M), 0.0);
+  for (int colour = 0; colour < 8; ++colour) {
+    const auto& blocks = grid.colour[colour];
+    ParallelFor(blocks.size(), 1, [&](size_t i) {
+      thread_local std::vector<Real> buf;
+      ScatterCellMoments<kDim, K>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+    });
+  }
+  // Steps 3-4: eps^h_p = M* S_p alpha_c (4.27), or for the hybrid M*_vol theta-bar_p +
+  // M*_dev S_p alpha_c (4.34); then f-bar_p and L_p.
+  ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+    const Vec3i origin = grid.block_origin[blk];
+    for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
+      const uint32_t p = grid.sorted[k];
+      if (p < begin || p >= end || !s.trial_ok[p]) continue;
+      Vec3i cell;
+      const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
+      const Vec3i lc = cell - origin;
+      const long g = PaddedToGrid(grid, blk, lc.x(), lc.y(), lc.z());
+      SURGE_ASSERT(g >= 0);
+      if (g < 0) continue;
+      const Real* a = &s.moments[size_t(g) * M];
+      F fit = CellFit<kDim>(a, xi, nullptr);
+      if (hybrid) {
+        if (!std::isfinite(s.theta_bar[p])) continue;  // left to CheckState
+        fit.q[0] = s.theta_bar[p];
+      } else if (al.approach == AntiLockingApproach::kConstantVolumetric) {
+        fit.q[0] = a[1 + kDim + F::kSym] / a[0];  // AS3CV: the trace constant (4.23)
+      }
+      const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
+      const Mat3 f_bar =
+          ProjectedIncrement<kDim>(f, fit.Tensor(s.trial_eps[p]), s.inv_stretch[p]);
+      if (f_bar.allFinite()) L[p] = (f_bar - Mat3::Identity()) / ctx.dt;
+    }
+  });
+}
+
 }  // namespace
 
 bool AnyAntiLocking(const Model& model) {
@@ -185,13 +462,22 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
   std::vector<Mat3>& L = velocity_gradient;
   for (const MaterialGroup& g : groups) {
     if (g.end == g.begin || size_t(g.material) >= model.antilocking.size()) continue;
-    const AntiLockingMethod method = model.antilocking[g.material].method;
+    const AntiLocking& al = model.antilocking[g.material];
+    const AntiLockingMethod method = al.method;
     if (method == AntiLockingMethod::kNone) continue;
     Mode mode;
-    mode.increment = model.antilocking[g.material].strain == AntiLockingStrain::kIncrement;
+    mode.increment = al.strain == AntiLockingStrain::kIncrement;
     mode.elastoplastic = std::visit(
         [](const auto& p) { return kIsElastoplastic<std::decay_t<decltype(p)>>; },
         model.materials[g.material].params);
+    if (method == AntiLockingMethod::kHybrid || al.approach != AntiLockingApproach::kVolumetric) {
+      SURGE_CHECK(method != AntiLockingMethod::kNode,
+                  "node-based full-tensor anti-locking is not implemented (the parser refuses it)");
+      DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
+        ProjectFullTensor<kDim, K>(ctx, particles, x_n, g.begin, g.end, grid, mode, al, scratch, L);
+      });
+      continue;
+    }
     DispatchProjection(model, method, [&]<int kDim, class K, bool kNode>() {
       const auto theta = [&](size_t p) {
         return TrialTheta<kDim>(Mat3::Identity() + ctx.dt * L[p], particles, p, mode);  // (2.18)

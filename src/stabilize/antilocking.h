@@ -17,6 +17,12 @@ namespace surge {
 struct AntiLockingScratch {
   std::vector<Real> weight;    // sum_p w_ip m_p over a control volume [kg]          (4.29), (4.25)
   std::vector<Real> weighted;  // sum_p w_ip m_p theta_p [kg]                        (4.29), (4.25)
+  // Full-tensor approaches (AS2, AS3CV, hybrid) only; per particle, then per cell.
+  std::vector<Mat3> trial_eps;    // trial (elastic) Hencky strain 1/2 ln b^tr       (4.36)-(4.38)
+  std::vector<Mat3> inv_stretch;  // (b^tr)^(-1/2)
+  std::vector<char> trial_ok;     // b^tr positive definite
+  std::vector<Real> theta_bar;    // hybrid: node-projected trace                    (4.34)_1
+  std::vector<Real> moments;      // cell moment sums, per grid slot of the cell's lower corner
 };
 
 // Replaces each anti-locked particle's velocity gradient L_p by (f-bar_p - I)/dt, where

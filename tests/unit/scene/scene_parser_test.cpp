@@ -758,11 +758,34 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   const std::string steel =
       "{model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3, ";
   ExpectError(WithMaterial(steel + "antilocking: {method: nodes}}"), 7,
-              "materials.steel.antilocking.method", "expected one of: none, node, cell");
+              "materials.steel.antilocking.method", "expected one of: none, node, cell, hybrid");
   ExpectError(WithMaterial(steel + "antilocking: {approach: volumetric}}"), 7,
               "materials.steel.antilocking.method", "missing required key 'method'");
-  ExpectError(WithMaterial(steel + "antilocking: {method: cell, approach: volumetric_deviatoric}}"),
-              7, "materials.steel.antilocking.approach", "not implemented yet");
+  ExpectError(WithMaterial(steel + "antilocking: {method: node, approach: volumetric_deviatoric}}"),
+              7, "materials.steel.antilocking.approach", "node-based full-tensor approximation is not implemented");
+  ExpectError(WithMaterial(steel + "antilocking: {method: hybrid, approach: constant_volumetric}}"),
+              7, "materials.steel.antilocking.approach", "approach volumetric_deviatoric");
+  ExpectError(WithMaterial(steel + "antilocking: {method: none, approach: constant_volumetric}}"),
+              7, "materials.steel.antilocking.approach", "needs a control volume");
+  ExpectError(WithMaterial(steel + "antilocking: {method: cell, approach: as2}}"), 7,
+              "materials.steel.antilocking.approach",
+              "expected one of: volumetric, volumetric_deviatoric, constant_volumetric");
+  ExpectError(WithMaterial(steel + "antilocking: {method: hybrid, stress: true}}"), 7,
+              "materials.steel.antilocking.stress", "volumetric approach only");
+  {  // full-tensor approaches: parsed, hybrid defaults to volumetric_deviatoric, and both read
+     // back from the resolved YAML
+    const LoadedScene as3 = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: cell, approach: constant_volumetric}}"), "ok.yaml");
+    EXPECT_EQ(as3.model.antilocking[0].approach, AntiLockingApproach::kConstantVolumetric);
+    EXPECT_EQ(LoadSceneFromString(as3.resolved_yaml, "again.yaml").model.antilocking[0].approach,
+              AntiLockingApproach::kConstantVolumetric);
+    const LoadedScene hb = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: hybrid}}"), "ok.yaml");
+    EXPECT_EQ(hb.model.antilocking[0].method, AntiLockingMethod::kHybrid);
+    EXPECT_EQ(hb.model.antilocking[0].approach, AntiLockingApproach::kVolumetricDeviatoric);
+    EXPECT_NE(hb.resolved_yaml.find("antilocking: {method: hybrid, approach: volumetric_deviatoric"),
+              std::string::npos) << hb.resolved_yaml;
+  }
   ExpectError(WithMaterial(steel + "antilocking: {method: cell, smoothing: 1}}"), 7,
               "materials.steel.antilocking.smoothing", "unknown key 'smoothing'");
   ExpectError(WithMaterial(steel + "antilocking: {method: cell, strain: trial}}"), 7,

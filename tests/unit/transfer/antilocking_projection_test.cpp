@@ -1,0 +1,283 @@
+// The full-tensor anti-locking projections (Mast 2013 (4.17)-(4.23), (4.33)-(4.35); src/stabilize,
+// docs/antilocking.md), called directly on hand-built states:
+//  - a homogeneous deformation is left unchanged by every approach (the fit reproduces constants);
+//  - AS2 (volumetric_deviatoric, cell) reproduces a field whose trace and normal deviator vary
+//    linearly and whose shears are constant; AS3CV makes the trace the cell's mass-weighted mean;
+//    the hybrid takes the node-based AS1 trace and keeps the deviator;
+//  - on a quadratic field AS2 is the weighted least-squares fit: its residual is orthogonal to
+//    [1, xi] in every cell;
+//  - the result is bitwise the same for 1 and 2 threads.
+// The trial strains are recomputed here with Eigen's solver, independently of the code under test.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <map>
+#include <random>
+#include <tuple>
+#include <vector>
+
+#include "transfer/transfer.h"
+#include "stabilize/antilocking.h"
+#include "support/test_state.h"
+
+namespace surge {
+namespace {
+
+constexpr Real kDt = 1e-3;
+
+// 1/2 log(b) of a symmetric positive definite b (Eigen's solver).
+Mat3 HalfLog(const Mat3& b) {
+  Eigen::SelfAdjointEigenSolver<Mat3> es(b);
+  return es.eigenvectors() * (0.5 * es.eigenvalues().array().log()).matrix().asDiagonal() *
+         es.eigenvectors().transpose();
+}
+Mat3 ExpSym(const Mat3& e) {
+  Eigen::SelfAdjointEigenSolver<Mat3> es(e);
+  return es.eigenvectors() * es.eigenvalues().array().exp().matrix().asDiagonal() *
+         es.eigenvectors().transpose();
+}
+
+// Filtered components as the seed defines them: 3-D {tr, e11, e22, e12, e13, e23}; 2-D
+// {e11 + e22, (e11 - e22)/2, e12}.
+std::vector<Real> Components(int dim, const Mat3& e) {
+  if (dim == 3) {
+    const Real tr = e.trace();
+    return {tr, e(0, 0) - tr / 3, e(1, 1) - tr / 3, e(0, 1), e(0, 2), e(1, 2)};
+  }
+  return {e(0, 0) + e(1, 1), (e(0, 0) - e(1, 1)) / 2, e(0, 1)};
+}
+Mat3 FromComponents(int dim, const std::vector<Real>& q) {
+  Mat3 e = Mat3::Zero();
+  if (dim == 3) {
+    const Real t = q[0] / 3;
+    e << t + q[1], q[3], q[4], q[3], t + q[2], q[5], q[4], q[5], t - q[1] - q[2];
+  } else {
+    e(0, 0) = q[0] / 2 + q[1];
+    e(1, 1) = q[0] / 2 - q[1];
+    e(0, 1) = e(1, 0) = q[2];
+  }
+  return e;
+}
+
+// A jittered lattice of 2 particles per cell and direction over a few cells, across a block
+// boundary (so the padded buffers and neighbour slots are exercised), random masses.
+State Lattice(int dim, Real dx) {
+  const int n = 10;  // particles per direction: 5 cells
+  State s = testing::RandomState(dim, dim == 3 ? n * n * n : n * n, Vec3::Zero(), 1, dx);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<Real> u(-0.1, 0.1);
+  size_t p = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < (dim == 3 ? n : 1); ++k, ++p) {
+        const Vec3 lattice(i + 0.5 + u(rng), j + 0.5 + u(rng), dim == 3 ? k + 0.5 + u(rng) : 0);
+        // cells 6..10 (x), 5..9 (y), 4..8 (z): across node 8, a block boundary
+        s.particles.x[p] = Vec3(6 * dx, 5 * dx, dim == 3 ? 4 * dx : 0) + lattice * (dx / 2);
+      }
+  return s;
+}
+
+struct Problem {
+  Model model;
+  State state;
+  SparseGrid grid;
+  StepContext ctx;
+  std::vector<Mat3> L;
+};
+
+Problem Make(int dim, ShapeFunction shape, AntiLockingMethod method, AntiLockingApproach approach) {
+  Problem s;
+  s.model = testing::SmallModel(dim, shape, TransferScheme::kApic, 0.1);
+  AntiLocking al;
+  al.method = method;
+  al.approach = approach;
+  s.model.antilocking = {al};
+  s.state = Lattice(dim, s.model.dx);
+  s.ctx.dt = kDt;
+  s.ctx.dx = s.model.dx;
+  s.ctx.inv_dx = 1 / s.model.dx;
+  s.L.assign(s.state.particles.size(), Mat3::Zero());
+  return s;
+}
+
+void Project(Problem& s) {
+  RebuildGrid(s.model, s.state.particles, s.grid);
+  AntiLockingScratch scratch;
+  ProjectVolumetricStrain(s.model, s.ctx, s.state.groups, s.state.particles, s.state.particles.x,
+                          s.grid, scratch, s.L);
+}
+
+// The trial strain 1/2 ln(f F F^T f^T) after the projection, f = I + dt L.
+Mat3 TrialStrain(const Problem& s, size_t p) {
+  const Mat3 f = Mat3::Identity() + kDt * s.L[p];
+  const Mat3 F = s.state.particles.F[p];
+  return HalfLog(f * F * F.transpose() * f.transpose());
+}
+
+using Case = std::tuple<int, ShapeFunction>;
+class FullTensorTest : public ::testing::TestWithParam<Case> {};
+
+const std::pair<AntiLockingMethod, AntiLockingApproach> kFullTensor[] = {
+    {AntiLockingMethod::kCell, AntiLockingApproach::kVolumetricDeviatoric},
+    {AntiLockingMethod::kCell, AntiLockingApproach::kConstantVolumetric},
+    {AntiLockingMethod::kHybrid, AntiLockingApproach::kVolumetricDeviatoric}};
+
+TEST_P(FullTensorTest, HomogeneousDeformationIsUnchanged) {
+  const auto [dim, shape] = GetParam();
+  Mat3 L0 = Mat3::Zero(), F0 = Mat3::Identity();
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  for (int i = 0; i < dim; ++i)
+    for (int j = 0; j < dim; ++j) {
+      L0(i, j) = u(rng);
+      F0(i, j) += 0.2 * u(rng);
+    }
+  for (const auto& [method, approach] : kFullTensor) {
+    Problem s = Make(dim, shape, method, approach);
+    for (size_t p = 0; p < s.L.size(); ++p) {
+      s.L[p] = L0;
+      s.state.particles.F[p] = F0;
+    }
+    Project(s);
+    Real err = 0;
+    for (const Mat3& l : s.L) err = std::max(err, (l - L0).norm());
+    EXPECT_LT(err, 1e-9 * L0.norm()) << int(method) << " " << int(approach);
+  }
+}
+
+// eps(x) with trace and normal deviator linear in x and constant shears (quadratic: the trace has a
+// quadratic term too).
+Mat3 Field(int dim, const Vec3& x, bool quadratic) {
+  const Vec3 y = x * 10;  // x in [0.6, 1.1] m: y in cell units
+  std::vector<Real> q;
+  if (dim == 3) {
+    q = {0.01 + 0.003 * y.x() - 0.002 * y.y() + 0.004 * y.z(), 0.02 - 0.001 * y.x() + 0.003 * y.z(),
+         -0.01 + 0.002 * y.y() - 0.001 * y.z(), 0.004, -0.003, 0.002};
+  } else {
+    q = {0.01 + 0.003 * y.x() - 0.002 * y.y(), 0.02 - 0.001 * y.x() + 0.003 * y.y(), 0.004};
+  }
+  if (quadratic) q[0] += 0.05 * (y.x() - 8) * (y.x() - 8) - 0.03 * (y.y() - 7) * (y.y() - 7);
+  return FromComponents(dim, q);
+}
+
+// Cells of the particles (floor(x/dx)).
+std::map<std::tuple<int, int, int>, std::vector<size_t>> Cells(const Problem& s) {
+  std::map<std::tuple<int, int, int>, std::vector<size_t>> cells;
+  const Particles& P = s.state.particles;
+  for (size_t p = 0; p < P.size(); ++p) {
+    const Vec3 c = (P.x[p] / s.model.dx).array().floor();
+    cells[{int(c.x()), int(c.y()), int(c.z())}].push_back(p);
+  }
+  return cells;
+}
+
+TEST_P(FullTensorTest, LinearFieldsAndTheTraceOfEachApproach) {
+  const auto [dim, shape] = GetParam();
+  const auto prepare = [&](AntiLockingMethod method, AntiLockingApproach approach) {
+    Problem s = Make(dim, shape, method, approach);
+    for (size_t p = 0; p < s.L.size(); ++p)
+      s.state.particles.F[p] = ExpSym(Field(dim, s.state.particles.x[p], false));
+    return s;
+  };
+  // AS2 reproduces the field: nothing changes.
+  Problem as2 = prepare(AntiLockingMethod::kCell, AntiLockingApproach::kVolumetricDeviatoric);
+  Project(as2);
+  Real err = 0;
+  for (const Mat3& l : as2.L) err = std::max(err, kDt * l.norm());
+  EXPECT_LT(err, 1e-12) << "AS2 must reproduce a linear trace and deviator";
+
+  // AS3CV: the trace becomes the cell's mass-weighted mean; the deviator and shears are kept.
+  Problem as3 = prepare(AntiLockingMethod::kCell, AntiLockingApproach::kConstantVolumetric);
+  Project(as3);
+  Real trace_err = 0, dev_err = 0, moved = 0;
+  for (const auto& [cell, members] : Cells(as3)) {
+    Real m = 0, mq = 0;
+    for (size_t p : members) {
+      m += as3.state.particles.mass[p];
+      mq += as3.state.particles.mass[p] * Components(dim, Field(dim, as3.state.particles.x[p], false))[0];
+    }
+    for (size_t p : members) {
+      const auto before = Components(dim, Field(dim, as3.state.particles.x[p], false));
+      const auto after = Components(dim, TrialStrain(as3, p));
+      trace_err = std::max(trace_err, std::abs(after[0] - mq / m));
+      moved = std::max(moved, std::abs(after[0] - before[0]));
+      for (size_t c = 1; c < before.size(); ++c)
+        dev_err = std::max(dev_err, std::abs(after[c] - before[c]));
+    }
+  }
+  EXPECT_LT(trace_err, 1e-10);
+  EXPECT_LT(dev_err, 1e-10);
+  EXPECT_GT(moved, 1e-4) << "the trace varies within a cell, so AS3CV must change it";
+
+  // Hybrid: the trace of node-based AS1, the deviator kept.
+  Problem hyb = prepare(AntiLockingMethod::kHybrid, AntiLockingApproach::kVolumetricDeviatoric);
+  Project(hyb);
+  Problem node = prepare(AntiLockingMethod::kNode, AntiLockingApproach::kVolumetric);
+  Project(node);
+  trace_err = dev_err = moved = 0;
+  for (size_t p = 0; p < hyb.L.size(); ++p) {
+    const auto before = Components(dim, Field(dim, hyb.state.particles.x[p], false));
+    const auto after = Components(dim, TrialStrain(hyb, p));
+    const auto as1 = Components(dim, TrialStrain(node, p));
+    trace_err = std::max(trace_err, std::abs(after[0] - as1[0]));
+    moved = std::max(moved, std::abs(after[0] - before[0]));
+    for (size_t c = 1; c < before.size(); ++c)
+      dev_err = std::max(dev_err, std::abs(after[c] - before[c]));
+  }
+  EXPECT_LT(trace_err, 1e-10);
+  EXPECT_LT(dev_err, 1e-10);
+  EXPECT_GT(moved, 1e-5) << "node-based smoothing of a field with boundaries changes the trace";
+}
+
+TEST_P(FullTensorTest, As2IsTheWeightedLeastSquaresFitInEachCell) {
+  const auto [dim, shape] = GetParam();
+  Problem s = Make(dim, shape, AntiLockingMethod::kCell, AntiLockingApproach::kVolumetricDeviatoric);
+  for (size_t p = 0; p < s.L.size(); ++p)
+    s.state.particles.F[p] = ExpSym(Field(dim, s.state.particles.x[p], true));
+  Project(s);
+  Real moved = 0, worst = 0;
+  for (const auto& [cell, members] : Cells(s)) {
+    // Residual r = q^h - q of the trace; sum m r [1, x] must vanish.
+    Real m = 0;
+    Vec3 mr = Vec3::Zero();
+    Real r0 = 0;
+    for (size_t p : members) {
+      const Real q = Components(dim, Field(dim, s.state.particles.x[p], true))[0];
+      const Real r = Components(dim, TrialStrain(s, p))[0] - q;
+      moved = std::max(moved, std::abs(r));
+      m += s.state.particles.mass[p];
+      r0 += s.state.particles.mass[p] * r;
+      mr += s.state.particles.mass[p] * r * (s.state.particles.x[p] / s.model.dx);
+    }
+    worst = std::max({worst, std::abs(r0) / m, mr.norm() / m});
+  }
+  EXPECT_GT(moved, 1e-4) << "a quadratic trace is not reproduced";
+  EXPECT_LT(worst, 1e-10);
+}
+
+TEST_P(FullTensorTest, BitwiseIndependentOfThreadCount) {
+  const auto [dim, shape] = GetParam();
+  std::vector<Mat3> out[2];
+  for (int t = 0; t < 2; ++t) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, t + 1);
+    Problem s = Make(dim, shape, AntiLockingMethod::kHybrid, AntiLockingApproach::kVolumetricDeviatoric);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<Real> u(-1, 1);
+    for (size_t p = 0; p < s.L.size(); ++p)
+      for (int i = 0; i < dim; ++i)
+        for (int j = 0; j < dim; ++j) s.L[p](i, j) = u(rng);
+    Project(s);
+    out[t] = s.L;
+  }
+  EXPECT_TRUE(out[0] == out[1]);
+}
+
+INSTANTIATE_TEST_SUITE_P(All, FullTensorTest,
+                         ::testing::Combine(::testing::Values(2, 3),
+                                            ::testing::Values(ShapeFunction::kLinear,
+                                                              ShapeFunction::kQuadraticBspline)));
+
+}  // namespace
+}  // namespace surge
