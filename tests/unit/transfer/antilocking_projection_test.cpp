@@ -125,7 +125,8 @@ const std::pair<AntiLockingMethod, AntiLockingApproach> kFullTensor[] = {
     {AntiLockingMethod::kHybrid, AntiLockingApproach::kVolumetricDeviatoric}};
 
 TEST_P(FullTensorTest, HomogeneousDeformationIsUnchanged) {
-  const auto [dim, shape] = GetParam();
+  const int dim = std::get<0>(GetParam());
+  const ShapeFunction shape = std::get<1>(GetParam());
   Mat3 L0 = Mat3::Zero(), F0 = Mat3::Identity();
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<Real> u(-1, 1);
@@ -174,7 +175,8 @@ std::map<std::tuple<int, int, int>, std::vector<size_t>> Cells(const Problem& s)
 }
 
 TEST_P(FullTensorTest, LinearFieldsAndTheTraceOfEachApproach) {
-  const auto [dim, shape] = GetParam();
+  const int dim = std::get<0>(GetParam());
+  const ShapeFunction shape = std::get<1>(GetParam());
   const auto prepare = [&](AntiLockingMethod method, AntiLockingApproach approach) {
     Problem s = Make(dim, shape, method, approach);
     for (size_t p = 0; p < s.L.size(); ++p)
@@ -232,7 +234,8 @@ TEST_P(FullTensorTest, LinearFieldsAndTheTraceOfEachApproach) {
 }
 
 TEST_P(FullTensorTest, As2IsTheWeightedLeastSquaresFitInEachCell) {
-  const auto [dim, shape] = GetParam();
+  const int dim = std::get<0>(GetParam());
+  const ShapeFunction shape = std::get<1>(GetParam());
   Problem s = Make(dim, shape, AntiLockingMethod::kCell, AntiLockingApproach::kVolumetricDeviatoric);
   for (size_t p = 0; p < s.L.size(); ++p)
     s.state.particles.F[p] = ExpSym(Field(dim, s.state.particles.x[p], true));
@@ -258,7 +261,8 @@ TEST_P(FullTensorTest, As2IsTheWeightedLeastSquaresFitInEachCell) {
 }
 
 TEST_P(FullTensorTest, BitwiseIndependentOfThreadCount) {
-  const auto [dim, shape] = GetParam();
+  const int dim = std::get<0>(GetParam());
+  const ShapeFunction shape = std::get<1>(GetParam());
   std::vector<Mat3> out[2];
   for (int t = 0; t < 2; ++t) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, t + 1);
