@@ -38,7 +38,9 @@ enum class ExitPolicy { kRemove, kStop };
 
 // Anti-locking of a material (Mast 2013 ch. 4; src/stabilize): the control volumes (4.25)-(4.35).
 // kHybrid: the trace from node-based control volumes, the deviator from cell-based ones (§4.4.3).
-enum class AntiLockingMethod { kNone, kNode, kCell, kHybrid };
+// kSmoothing: Anura3D's strain smoothing (nodal mixed discretisation, manual §6.7, (6.34)-(6.37)):
+// cell values of the volumetric strain averaged to the nodes and back to the cells.
+enum class AntiLockingMethod { kNone, kNode, kCell, kHybrid, kSmoothing };
 // What is approximated (seed (4.14)-(4.23)): kVolumetric = AS1, the trace only, constant over the
 // control volume; kVolumetricDeviatoric = AS2, the full tensor: trace, e11, e22 linear in the
 // control volume, the shears constant; kConstantVolumetric = AS3CV, AS2 with a constant trace.

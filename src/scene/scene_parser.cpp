@@ -56,7 +56,8 @@ constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
 constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockingMethod::kNone},
                                                              {"node", AntiLockingMethod::kNode},
                                                              {"cell", AntiLockingMethod::kCell},
-                                                             {"hybrid", AntiLockingMethod::kHybrid}};
+                                                             {"hybrid", AntiLockingMethod::kHybrid},
+                                                             {"smoothing", AntiLockingMethod::kSmoothing}};
 constexpr EnumName<AntiLockingApproach> kAntiLockingApproachNames[] = {
     {"volumetric", AntiLockingApproach::kVolumetric},
     {"volumetric_deviatoric", AntiLockingApproach::kVolumetricDeviatoric},
@@ -593,6 +594,11 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
              "method hybrid takes the trace from node-based and the deviator from cell-based "
              "control volumes (seed (4.33)-(4.35)): approach volumetric_deviatoric (or leave it out)");
       }
+      if (full && *m.antilocking == AntiLockingMethod::kSmoothing) {
+        Fail(a, Child(ap, "approach"),
+             "strain smoothing (Anura3D manual §6.7) smooths the volumetric strain only: approach "
+             "volumetric (or leave it out)");
+      }
       if (full && *m.antilocking == AntiLockingMethod::kNode) {
         Fail(a, Child(ap, "approach"),
              "the node-based full-tensor approximation is not implemented: use method cell or "
@@ -603,6 +609,8 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
                                            " needs a control volume: method cell or hybrid");
       }
     }
+    // Anura3D smooths the strain rate (manual (6.34)-(6.37)): the increment by default.
+    if (*m.antilocking == AntiLockingMethod::kSmoothing) m.antilocking_strain = AntiLockingStrain::kIncrement;
     if (al["strain"]) {
       m.antilocking_strain = Enum(al["strain"], Child(ap, "strain"), kAntiLockingStrainNames);
     }
@@ -610,6 +618,10 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
       m.antilocking_stress = Bool(st, Child(ap, "stress"));
       if (m.antilocking_stress && *m.antilocking == AntiLockingMethod::kNone) {
         Fail(st, Child(ap, "stress"), "stress averaging needs a control volume: method node or cell");
+      }
+      if (m.antilocking_stress && *m.antilocking == AntiLockingMethod::kSmoothing) {
+        Fail(st, Child(ap, "stress"),
+             "stress averaging is implemented for method node or cell only, not for smoothing");
       }
       if (m.antilocking_stress && m.antilocking_approach != AntiLockingApproach::kVolumetric) {
         Fail(st, Child(ap, "stress"),

@@ -49,6 +49,25 @@ Real TrialTheta(const Mat3& f, const Particles& P, size_t p, const Mode& mode) {
   return std::log(Det<kDim>(f) * jn);
 }
 
+// Seed §3.5 (AS1 as a hydrostatic shift): each principal trial log strain moves by
+// (theta-bar - theta)/dim, i.e. f-bar = exp((theta-bar - theta)/dim) f, so that
+// ln det(f-bar) + ln J_n = theta-bar; the deviatoric part of f is kept (P = I_dev, (4.16)).
+// Replaces L_p by (f-bar - I)/dt. An inverted particle (theta_p not finite) is left to CheckState.
+template <int kDim>
+void ShiftVolumetric(const StepContext& ctx, const Particles& P, size_t p, const Mode& mode,
+                     Real theta_bar, Mat3& L) {
+  Mat3 f = Mat3::Identity() + ctx.dt * L;  // (2.18)
+  const Real theta_p = TrialTheta<kDim>(f, P, p, mode);
+  if (!std::isfinite(theta_p)) return;
+  const Real scale = std::exp((theta_bar - theta_p) / kDim);
+  if constexpr (kDim == 3) {
+    f *= scale;
+  } else {
+    f.template topLeftCorner<2, 2>() *= scale;
+  }
+  L = (f - Mat3::Identity()) / ctx.dt;
+}
+
 // Control-volume sums of a per-particle quantity q_p = value(p) over one block's particles of
 // group [begin, end), weight m_p, into its padded buffer, then into the grid slots (fixed order:
 // particle order, then colour order). Node-based: weight N_ip m_p at every stencil node (4.29).
@@ -445,6 +464,83 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
   });
 }
 
+// Anura3D's strain smoothing (manual §6.7, the nodal mixed discretisation of Detournay & Dzik
+// 2006, (6.34)-(6.37)) on the grid's cells: the cell value theta_c is the mass-weighted mean of the
+// cell's particles (the MPM cell has no Gauss point of its own; this is cell-based AS1, (4.25));
+// each node takes the mean over the non-empty cells around it (6.35: element-volume weights, all
+// equal on a regular grid); each cell takes the mean of its 2^dim corner nodes (6.36); and each
+// particle's volumetric strain is replaced by its cell's value, the deviatoric part kept (6.37).
+// Cell sums in the slot of the cell's lower corner node, as ScatterBlock's cell branch.
+template <int kDim, class K>
+void SmoothVolumetricStrain(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                            size_t begin, size_t end, const SparseGrid& grid, const Mode& mode,
+                            AntiLockingScratch& s, std::vector<Mat3>& L) {
+  const size_t slots = grid.block_count() * kBlockNodes;
+  s.weight.assign(slots, 0.0);
+  s.weighted.assign(slots, 0.0);
+  const auto theta = [&](size_t p) {
+    return TrialTheta<kDim>(Mat3::Identity() + ctx.dt * L[p], P, p, mode);  // (2.18)
+  };
+  for (int colour = 0; colour < 8; ++colour) {
+    const auto& blocks = grid.colour[colour];
+    ParallelFor(blocks.size(), 1, [&](size_t i) {
+      thread_local std::vector<Accum> buf;
+      ScatterBlock<kDim, K, false>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s, theta);
+    });
+  }
+  // (6.35): node value = mean of the cell values around it, colour-phased (a cell writes its own
+  // block and its + neighbours), so the sums are in a fixed order.
+  s.node_sum.assign(slots, 0.0);
+  s.node_count.assign(slots, 0.0);
+  constexpr int kz = kDim == 3 ? 2 : 1;
+  for (int colour = 0; colour < 8; ++colour) {
+    const auto& blocks = grid.colour[colour];
+    ParallelFor(blocks.size(), 1, [&](size_t i) {
+      const size_t blk = size_t(blocks[i]);
+      for (int l = 0; l < kBlockNodes; ++l) {
+        const size_t g = blk * kBlockNodes + size_t(l);
+        if (s.weight[g] == 0) continue;  // an empty cell
+        const Real theta_c = s.weighted[g] / s.weight[g];
+        const int lx = l / (kBlockDim * kBlockDim), ly = (l / kBlockDim) % kBlockDim, lz = l % kBlockDim;
+        for (int a = 0; a < 2; ++a)
+          for (int b = 0; b < 2; ++b)
+            for (int c = 0; c < kz; ++c) {
+              const long n = PaddedToGrid(grid, blk, lx + a, ly + b, lz + c);
+              SURGE_ASSERT(n >= 0);  // a corner of a non-empty cell is in its particles' stencils
+              if (n < 0) continue;
+              s.node_sum[size_t(n)] += theta_c;
+              s.node_count[size_t(n)] += 1;
+            }
+      }
+    });
+  }
+  // (6.36)-(6.37): the cell's mean of its corner nodes replaces the particle's volumetric strain.
+  ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+    const Vec3i origin = grid.block_origin[blk];
+    for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
+      const uint32_t p = grid.sorted[k];
+      if (p < begin || p >= end) continue;
+      Vec3i cell = Vec3i::Zero();
+      for (int d = 0; d < kDim; ++d) cell[d] = int(std::floor(x_n[p][d] * ctx.inv_dx));
+      const Vec3i lc = cell - origin;
+      Real sum = 0;
+      bool ok = true;
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+          for (int c = 0; c < kz; ++c) {
+            const long n = PaddedToGrid(grid, blk, lc.x() + a, lc.y() + b, lc.z() + c);
+            if (n < 0 || s.node_count[size_t(n)] == 0) {
+              ok = false;  // the particle's own cell was skipped (non-finite theta): CheckState
+              continue;
+            }
+            sum += s.node_sum[size_t(n)] / s.node_count[size_t(n)];
+          }
+      const Real theta_bar = sum / Real(2 * 2 * kz);
+      if (ok && std::isfinite(theta_bar)) ShiftVolumetric<kDim>(ctx, P, p, mode, theta_bar, L[p]);
+    }
+  });
+}
+
 }  // namespace
 
 bool AnyAntiLocking(const Model& model) {
@@ -470,6 +566,12 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
     mode.elastoplastic = std::visit(
         [](const auto& p) { return kIsElastoplastic<std::decay_t<decltype(p)>>; },
         model.materials[g.material].params);
+    if (method == AntiLockingMethod::kSmoothing) {
+      DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
+        SmoothVolumetricStrain<kDim, K>(ctx, particles, x_n, g.begin, g.end, grid, mode, scratch, L);
+      });
+      continue;
+    }
     if (method == AntiLockingMethod::kHybrid || al.approach != AntiLockingApproach::kVolumetric) {
       SURGE_CHECK(method != AntiLockingMethod::kNode,
                   "node-based full-tensor anti-locking is not implemented (the parser refuses it)");
@@ -482,20 +584,8 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
       const auto theta = [&](size_t p) {
         return TrialTheta<kDim>(Mat3::Identity() + ctx.dt * L[p], particles, p, mode);  // (2.18)
       };
-      // Seed §3.5 (AS1 as a hydrostatic shift): each principal trial log strain moves by
-      // (theta-bar - theta)/dim, i.e. f-bar = exp((theta-bar - theta)/dim) f, so that
-      // ln det(f-bar) + ln J_n = theta-bar; the deviatoric part of f is kept (P = I_dev, (4.16)).
       const auto shift = [&](size_t p, Real theta_bar) {
-        Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
-        const Real theta_p = TrialTheta<kDim>(f, particles, p, mode);
-        if (!std::isfinite(theta_p)) return;  // inverted: left to CheckState
-        const Real scale = std::exp((theta_bar - theta_p) / kDim);
-        if constexpr (kDim == 3) {
-          f *= scale;
-        } else {
-          f.template topLeftCorner<2, 2>() *= scale;
-        }
-        L[p] = (f - Mat3::Identity()) / ctx.dt;
+        ShiftVolumetric<kDim>(ctx, particles, p, mode, theta_bar, L[p]);
       };
       Project<kDim, K, kNode>(ctx, particles, x_n, g.begin, g.end, grid, scratch, theta, shift);
     });

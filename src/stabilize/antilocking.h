@@ -23,6 +23,9 @@ struct AntiLockingScratch {
   std::vector<char> trial_ok;     // b^tr positive definite
   std::vector<Real> theta_bar;    // hybrid: node-projected trace                    (4.34)_1
   std::vector<Real> moments;      // cell moment sums, per grid slot of the cell's lower corner
+  // Strain smoothing (Anura3D §6.7) only: per node, the sum and count of the cell values around it.
+  std::vector<Real> node_sum;    // (6.35)
+  std::vector<Real> node_count;
 };
 
 // Replaces each anti-locked particle's velocity gradient L_p by (f-bar_p - I)/dt, where

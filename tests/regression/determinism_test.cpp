@@ -82,7 +82,8 @@ TEST(DeterminismTest, AntiLockedScenesAreBitwiseIdenticalForOneAndTwoThreads) {
             RunWithThreads("column_collapse_2d.yaml", sand, 0.03, 2));
   // The full-tensor approaches: hybrid (node trace, cell deviator) and AS3CV on the sand's trial
   // elastic strain; the cell moment scatter must keep the fixed order too.
-  for (const char* al : {"{method: hybrid}", "{method: cell, approach: constant_volumetric}"}) {
+  for (const char* al : {"{method: hybrid}", "{method: cell, approach: constant_volumetric}",
+                         "{method: smoothing}"}) {
     std::vector<std::string> full = sand;
     full.back() = std::string("materials.sand.antilocking=") + al;
     EXPECT_EQ(RunWithThreads("column_collapse_2d.yaml", full, 0.03, 1),

@@ -758,7 +758,7 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   const std::string steel =
       "{model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3, ";
   ExpectError(WithMaterial(steel + "antilocking: {method: nodes}}"), 7,
-              "materials.steel.antilocking.method", "expected one of: none, node, cell, hybrid");
+              "materials.steel.antilocking.method", "expected one of: none, node, cell, hybrid, smoothing");
   ExpectError(WithMaterial(steel + "antilocking: {approach: volumetric}}"), 7,
               "materials.steel.antilocking.method", "missing required key 'method'");
   ExpectError(WithMaterial(steel + "antilocking: {method: node, approach: volumetric_deviatoric}}"),
@@ -772,6 +772,21 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
               "expected one of: volumetric, volumetric_deviatoric, constant_volumetric");
   ExpectError(WithMaterial(steel + "antilocking: {method: hybrid, stress: true}}"), 7,
               "materials.steel.antilocking.stress", "volumetric approach only");
+  ExpectError(WithMaterial(steel + "antilocking: {method: smoothing, approach: volumetric_deviatoric}}"),
+              7, "materials.steel.antilocking.approach", "smooths the volumetric strain only");
+  ExpectError(WithMaterial(steel + "antilocking: {method: smoothing, stress: true}}"), 7,
+              "materials.steel.antilocking.stress", "not for smoothing");
+  {  // strain smoothing: the increment by default (Anura3D smooths the strain rate), total allowed
+    const LoadedScene sm = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: smoothing}}"), "ok.yaml");
+    EXPECT_EQ(sm.model.antilocking[0].method, AntiLockingMethod::kSmoothing);
+    EXPECT_EQ(sm.model.antilocking[0].strain, AntiLockingStrain::kIncrement);
+    EXPECT_EQ(LoadSceneFromString(sm.resolved_yaml, "again.yaml").model.antilocking[0].strain,
+              AntiLockingStrain::kIncrement);
+    const LoadedScene total = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: smoothing, strain: total}}"), "ok.yaml");
+    EXPECT_EQ(total.model.antilocking[0].strain, AntiLockingStrain::kTotal);
+  }
   {  // full-tensor approaches: parsed, hybrid defaults to volumetric_deviatoric, and both read
      // back from the resolved YAML
     const LoadedScene as3 = LoadSceneFromString(

@@ -122,7 +122,8 @@ class FullTensorTest : public ::testing::TestWithParam<Case> {};
 const std::pair<AntiLockingMethod, AntiLockingApproach> kFullTensor[] = {
     {AntiLockingMethod::kCell, AntiLockingApproach::kVolumetricDeviatoric},
     {AntiLockingMethod::kCell, AntiLockingApproach::kConstantVolumetric},
-    {AntiLockingMethod::kHybrid, AntiLockingApproach::kVolumetricDeviatoric}};
+    {AntiLockingMethod::kHybrid, AntiLockingApproach::kVolumetricDeviatoric},
+    {AntiLockingMethod::kSmoothing, AntiLockingApproach::kVolumetric}};
 
 TEST_P(FullTensorTest, HomogeneousDeformationIsUnchanged) {
   const int dim = std::get<0>(GetParam());
@@ -276,6 +277,69 @@ TEST_P(FullTensorTest, BitwiseIndependentOfThreadCount) {
     out[t] = s.L;
   }
   EXPECT_TRUE(out[0] == out[1]);
+}
+
+// Anura3D's strain smoothing (manual (6.35)-(6.37)) against a direct re-implementation: cell value
+// = mass-weighted mean of ln det f over the cell's particles, node value = mean over the non-empty
+// cells around the node, particle value = mean of its cell's corner nodes; the deviatoric part of
+// f is kept.
+TEST_P(FullTensorTest, SmoothingIsTheCellNodeCellAverageOfTheVolumetricIncrement) {
+  const int dim = std::get<0>(GetParam());
+  const ShapeFunction shape = std::get<1>(GetParam());
+  Problem s = Make(dim, shape, AntiLockingMethod::kSmoothing, AntiLockingApproach::kVolumetric);
+  s.model.antilocking[0].strain = AntiLockingStrain::kIncrement;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  for (size_t p = 0; p < s.L.size(); ++p)
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j) s.L[p](i, j) = u(rng);
+  const std::vector<Mat3> before = s.L;
+  const auto det = [&](const Mat3& L) {
+    const Mat3 f = Mat3::Identity() + kDt * L;
+    return dim == 3 ? f.determinant() : f(0, 0) * f(1, 1) - f(0, 1) * f(1, 0);
+  };
+  Project(s);
+  const Particles& P = s.state.particles;
+  using Key = std::tuple<int, int, int>;
+  std::map<Key, std::pair<Real, Real>> cell;  // sum m, sum m theta
+  std::vector<Key> cell_of(P.size());
+  for (size_t p = 0; p < P.size(); ++p) {
+    const Vec3 c = (P.x[p] / s.model.dx).array().floor();
+    cell_of[p] = {int(c.x()), int(c.y()), int(c.z())};
+    cell[cell_of[p]].first += P.mass[p];
+    cell[cell_of[p]].second += P.mass[p] * std::log(det(before[p]));
+  }
+  const int kz = dim == 3 ? 2 : 1;
+  std::map<Key, std::pair<Real, int>> node;  // sum of cell values, count
+  for (const auto& [c, acc] : cell)
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b)
+        for (int z = 0; z < kz; ++z) {
+          auto& n = node[{std::get<0>(c) + a, std::get<1>(c) + b, std::get<2>(c) + z}];
+          n.first += acc.second / acc.first;
+          n.second += 1;
+        }
+  Real err = 0, moved = 0, dev = 0;
+  for (size_t p = 0; p < P.size(); ++p) {
+    const auto [cx, cy, cz] = cell_of[p];
+    Real expect = 0;
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b)
+        for (int z = 0; z < kz; ++z) {
+          const auto& n = node.at({cx + a, cy + b, cz + z});
+          expect += n.first / n.second;
+        }
+    expect /= 2 * 2 * kz;
+    err = std::max(err, std::abs(std::log(det(s.L[p])) - expect));
+    moved = std::max(moved, std::abs(std::log(det(before[p])) - expect));
+    // The isochoric part of f is kept: f-bar = lambda f.
+    const Mat3 f0 = Mat3::Identity() + kDt * before[p], f1 = Mat3::Identity() + kDt * s.L[p];
+    const Real lambda = f1(0, 0) / f0(0, 0);
+    dev = std::max(dev, (f1.topLeftCorner(dim, dim) - lambda * f0.topLeftCorner(dim, dim)).norm());
+  }
+  EXPECT_LT(err, 1e-12);
+  EXPECT_LT(dev, 1e-12);
+  EXPECT_GT(moved, 1e-4) << "random increments must be smoothed";
 }
 
 INSTANTIATE_TEST_SUITE_P(All, FullTensorTest,
