@@ -60,6 +60,16 @@ struct AntiLocking {
 // (6.22)-(6.23); docs/antilocking.md "Local damping"): f_damp = -alpha |f| sign(v) per component of
 // every node, f = f_ext - f_int the unbalanced force. One alpha for the whole grid, as the manual
 // gives one per degree of freedom; active for t < until (quasi-static initialisation, §6.4).
+// Mass scaling for quasi-static phases (Anura3D manual §6.5, (6.31)): the density in the momentum
+// balance is beta rho (the nodal inertia is scaled by beta; the weight, the internal and the
+// external forces are not), so the critical time step grows by sqrt(beta). Active for t < until;
+// the manual warns that a large beta changes the result: use it to settle a body, then let go.
+struct MassScaling {
+  Real factor = 1;      // beta >= 1 [-]; 1 = off
+  Real until = 1e300;   // scaling acts while t_n < until [s]; default: the whole run
+  Real At(Real t) const { return t < until ? factor : 1; }
+};
+
 struct LocalDamping {
   Real alpha = 0;        // local damping factor [-], 0 <= alpha < 1; 0 = off
   Real until = 1e300;    // damping acts while t_n < until [s]; default: the whole run
@@ -132,6 +142,7 @@ struct Model {
   std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none
   std::vector<BulkViscosity> bulk_viscosity;  // per material (index as materials); empty = none
   LocalDamping damping;                  // scene key `damping` (off by default)
+  MassScaling mass_scaling;              // scene key `mass_scaling` (off by default)
   std::vector<BodyInfo> bodies;
   std::vector<Obstacle> obstacles;       // rigid structures (src/contact), in scene order
   std::vector<Sensor> sensors;           // force sensors (src/contact), in scene order

@@ -12,6 +12,7 @@ struct StepContext {
   Real ramp = 1;              // external load factor min(t/t_c, 1) (seed App. B.2.3)
   Vec3 gravity = Vec3::Zero();  // ramped gravity [m/s^2]
   Real damping = 0;           // local damping factor alpha of this step (Model::damping) [-]
+  Real mass_scale = 1;        // inertia factor beta of this step (Model::mass_scaling) [-]
 };
 
 }  // namespace surge

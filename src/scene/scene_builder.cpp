@@ -337,6 +337,8 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   }
   model.damping.alpha = spec.damping.local;
   if (spec.damping.until) model.damping.until = *spec.damping.until;
+  model.mass_scaling.factor = spec.mass_scaling.factor;
+  if (spec.mass_scaling.until) model.mass_scaling.until = *spec.mass_scaling.until;
   for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
   for (size_t o = 0; o < spec.obstacles.size(); ++o) model.obstacles.push_back(BuildObstacle(spec, o));
   for (const SensorSpec& s : spec.sensors) model.sensors.push_back(Sensor{s.name, s.min, s.max});

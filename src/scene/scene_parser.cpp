@@ -1193,7 +1193,7 @@ AnalysisSpec Parser::ParseAnalysis(const YAML::Node& n, const SceneSpec& spec) c
 SceneSpec Parser::Parse(const YAML::Node& root) {
   SceneSpec spec;
   const std::vector<std::string> top = {"name",   "dimension", "time",      "gravity", "gravity_ramp",
-                                        "damping", "grid",     "domain",    "materials", "bodies",
+                                        "damping", "mass_scaling", "grid", "domain", "materials", "bodies",
                                         "obstacles", "sensors", "body_contact", "output", "analysis",
                                         "parameters"};
   if (!root.IsDefined() || root.IsNull()) {
@@ -1224,6 +1224,14 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
     spec.damping.loc = Loc(d, "damping");
     spec.damping.local = Ranged(Need(d, "damping", "local"), "damping.local", "-", 0, true, 1, false);
     if (d["until"]) spec.damping.until = Positive(d["until"], "damping.until", "s");
+  }
+  if (const YAML::Node ms = root["mass_scaling"]) {
+    // mass_scaling: {factor: beta, until: t} (Anura3D manual §6.5; docs/scene-reference.md).
+    ExpectMap(ms, "mass_scaling", {"factor", "until"});
+    spec.mass_scaling.loc = Loc(ms, "mass_scaling");
+    spec.mass_scaling.factor =
+        Ranged(Need(ms, "mass_scaling", "factor"), "mass_scaling.factor", "-", 1, true, kInf, false);
+    if (ms["until"]) spec.mass_scaling.until = Positive(ms["until"], "mass_scaling.until", "s");
   }
 
   {
@@ -1401,6 +1409,11 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
       // consistently with the common field is not implemented.
       Fail(root["damping"]["local"], "damping.local",
            "local damping does not work with body_contact yet (per-body velocity fields)");
+    }
+    if (spec.mass_scaling.factor > 1) {
+      // The per-body fields carry their own masses and momenta; scaling them is not implemented.
+      Fail(root["mass_scaling"]["factor"], "mass_scaling.factor",
+           "mass scaling does not work with body_contact yet (per-body velocity fields)");
     }
   }
 
@@ -1632,6 +1645,14 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     e << YAML::Key << "damping" << YAML::Value << YAML::Flow << YAML::BeginMap;
     e << YAML::Key << "local" << YAML::Value << Num(spec.damping.local);
     if (spec.damping.until) e << YAML::Key << "until" << YAML::Value << Num(*spec.damping.until);
+    e << YAML::EndMap;
+  }
+  if (spec.mass_scaling.factor > 1) {  // only when on: resolved scenes without it stay the same
+    e << YAML::Key << "mass_scaling" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    e << YAML::Key << "factor" << YAML::Value << Num(spec.mass_scaling.factor);
+    if (spec.mass_scaling.until) {
+      e << YAML::Key << "until" << YAML::Value << Num(*spec.mass_scaling.until);
+    }
     e << YAML::EndMap;
   }
 

@@ -256,6 +256,13 @@ struct DampingSpec {
   SourceLoc loc;
 };
 
+// `mass_scaling:` (docs/scene-reference.md): Anura3D mass scaling (core/model.h MassScaling).
+struct MassScalingSpec {
+  Real factor = 1;             // beta [-], >= 1; 1 = off
+  std::optional<Real> until;   // [s]; unset = the whole run
+  SourceLoc loc;
+};
+
 struct SceneSpec {
   std::string name;
   int dimension = 3;
@@ -263,6 +270,7 @@ struct SceneSpec {
   Vec3 gravity = Vec3::Zero();  // [m/s^2]
   Real gravity_ramp = 0;        // [s]
   DampingSpec damping;
+  MassScalingSpec mass_scaling;
   GridSpec grid;
   DomainSpec domain;
   std::vector<MaterialSpec> materials;  // in file order; Model::materials has the same order

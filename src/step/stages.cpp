@@ -20,6 +20,17 @@ void RebuildGridStage(const Model& m, const StepContext&, State& s, Workspace& w
 void ParticleToGridStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                          StepReport&) {
   ParticleToGrid(m, c, s.particles, w.grid);
+  if (c.mass_scale != 1) {
+    // Mass scaling (Anura3D manual §6.5): the nodal inertia beta m_i and momentum beta m_i v_i
+    // (the velocity v_i is unchanged); every later stage that turns a velocity change into a
+    // force (walls, obstacles, sensors, damping) then logs the force on the scaled inertia, the
+    // one that balances the unscaled loads. Gravity is g / beta (Step).
+    const Real beta = c.mass_scale;
+    ParallelFor(w.grid.mass.size(), 4096, [&](size_t i) {
+      w.grid.mass[i] *= beta;
+      w.grid.momentum[i] *= beta;
+    });
+  }
 }
 
 void GridUpdateStage(const Model& m, const StepContext& c, State& s, Workspace& w,

@@ -80,7 +80,10 @@ void Step(const Model& model, const Pipeline& pipeline, State& state, Workspace&
   ctx.dx = model.dx;
   ctx.inv_dx = 1.0 / model.dx;
   ctx.ramp = RampFactor(model, state.time);
-  ctx.gravity = ctx.ramp * model.gravity;
+  ctx.mass_scale = model.mass_scaling.At(state.time);  // Anura3D §6.5: beta, 1 after until
+  // With mass scaling the grid's inertia is beta m_i (ParticleToGridStage) while the weight stays
+  // m_i g: as an acceleration on the scaled inertia, gravity is g / beta.
+  ctx.gravity = ctx.ramp * model.gravity / ctx.mass_scale;
   ctx.damping = model.damping.At(state.time);  // Anura3D §6.3: alpha, 0 after damping.until
   if (!(ctx.dt >= model.time.min_dt) || !std::isfinite(ctx.dt)) {
     report.health = Health{HealthStatus::kTimeStepTooSmall, -1,
@@ -111,8 +114,10 @@ Real NextTimeStep(const Model& model, const State& state) {
   if (dt <= 0) {
     const Particles& P = state.particles;
     Real max_speed = 0;
+    // Mass scaling (Anura3D (6.31)): the wave speed in the scaled density beta rho is c/sqrt(beta).
+    const Real beta = model.mass_scaling.At(state.time);
     for (const MaterialGroup& g : state.groups) {
-      const Real c = WaveSpeed(model.materials[g.material]);
+      const Real c = WaveSpeed(model.materials[g.material]) / std::sqrt(beta);
       std::array<Real, kReductionChunks> partial{};
       ParallelChunks(g.end - g.begin, [&](size_t chunk, size_t b, size_t e) {
         Real vmax = 0;
@@ -123,7 +128,8 @@ Real NextTimeStep(const Model& model, const State& state) {
       if (g.end > g.begin) max_speed = std::max(max_speed, c + vmax);
     }
     dt = max_speed > 0 ? model.time.cfl * model.dx / max_speed : model.time.max_dt;  // spec §1.7
-    dt = std::min({dt, ViscousTimeStep(model, state), model.time.max_dt});
+    // The viscous bound is proportional to the density: beta times larger while scaled.
+    dt = std::min({dt, beta * ViscousTimeStep(model, state), model.time.max_dt});
   }
   // Land exactly on the end time; never take a sliver step afterwards.
   if (remaining > 0 && dt > remaining) dt = remaining;

@@ -127,7 +127,9 @@ void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGri
       const size_t i = b * kBlockNodes + l;
       const Real m = grid.mass[i];
       if (m <= 0) continue;
-      Vec3 v = grid.momentum[i] / m;
+      // The re-mapped momentum is sum N m_p v_p; with mass scaling the nodal mass is beta m_i
+      // (ParticleToGridStage), so the velocity takes the same factor.
+      Vec3 v = ctx.mass_scale * grid.momentum[i] / m;
       if (wall_count > 0) {
         const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
         Vec3 dv[kFaceCount];

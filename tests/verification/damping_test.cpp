@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "support/run_scene.h"
 
@@ -134,6 +135,148 @@ TEST(DampingTest, DampedColumnSettlesToGeostaticAndStaysAfterRelease) {
               plain.max_speed);
   EXPECT_GT(plain.max_change, 5 * damped.max_change);
   EXPECT_GT(plain.max_speed, 5 * damped.max_speed);
+}
+
+// ---- Mass scaling (Anura3D manual §6.5, (6.31); docs/antilocking.md "Mass scaling") ----
+
+// The scene text with `extra` top-level lines in place of the damping line.
+std::string WithTopLevel(const std::string& extra) {
+  std::string text = kScene;
+  text.erase(text.find("damping:"), text.find("grid:") - text.find("damping:"));
+  return text.insert(text.find("grid:"), extra);
+}
+
+struct Ringing {
+  Real period = 0;      // mean period of the column's mean vertical velocity [s]
+  Real amplitude = 0;   // largest mean vertical displacement [m]
+  Real mean_dt = 0;     // [s]
+  size_t steps = 0;
+};
+
+// The undamped, suddenly loaded column rings in its first vertical mode.
+Ringing Ring(const std::string& text, Real end) {
+  LoadedScene scene = LoadSceneFromString(text, "ringing_column.yaml");
+  std::unordered_map<int64_t, Real> y0;
+  for (size_t p = 0; p < scene.state.particles.size(); ++p)
+    y0[scene.state.particles.id[p]] = scene.state.particles.x[p].y();
+  std::vector<Real> t, v;
+  Ringing r;
+  testing::RunUntil(scene, end, [&](const State& s, const StepReport&) {
+    const Particles& P = s.particles;
+    Real m = 0, mv = 0, mu = 0;
+    for (size_t p = 0; p < P.size(); ++p) {
+      m += P.mass[p];
+      mv += P.mass[p] * P.v[p].y();
+      mu += P.mass[p] * (P.x[p].y() - y0.at(P.id[p]));
+    }
+    t.push_back(s.time);
+    v.push_back(mv / m);
+    r.amplitude = std::max(r.amplitude, std::abs(mu / m));
+  });
+  r.steps = t.size();
+  r.mean_dt = t.back() / Real(t.size());
+  r.period = testing::PeriodFromCrossings(testing::ZeroCrossings(t, v));
+  return r;
+}
+
+// With the inertia scaled by beta and the weight not, the motion is the physical one slowed by
+// sqrt(beta): beta m x'' = f(x) + m g is solved by x(t) = x_1(t / sqrt(beta)) (the time step of
+// (6.31) grows by the same factor). beta = 4: the ringing period doubles, its displacement
+// amplitude stays, and the steps per simulated second halve.
+TEST(MassScalingTest, ScaledInertiaSlowsTheMotionBySqrtBeta) {
+  const Ringing plain = Ring(WithTopLevel(""), 0.5);
+  const Ringing scaled = Ring(WithTopLevel("mass_scaling: {factor: 4}\n"), 1.0);
+  std::printf("ringing column: period %.5f s -> %.5f s (ratio %.4f), amplitude %.4g -> %.4g m "
+              "(ratio %.4f), mean dt %.4g -> %.4g s (ratio %.4f), steps %zu -> %zu\n",
+              plain.period, scaled.period, scaled.period / plain.period, plain.amplitude,
+              scaled.amplitude, scaled.amplitude / plain.amplitude, plain.mean_dt, scaled.mean_dt,
+              scaled.mean_dt / plain.mean_dt, plain.steps, scaled.steps);
+  EXPECT_NEAR(scaled.period / plain.period, 2.0, 0.02 * 2.0);
+  EXPECT_NEAR(scaled.amplitude / plain.amplitude, 1.0, 0.02);
+  EXPECT_NEAR(scaled.mean_dt / plain.mean_dt, 2.0, 0.02 * 2.0);
+  // The same with USL (no momentum re-map; the scaled P2G alone).
+  std::string usl = WithTopLevel("mass_scaling: {factor: 4}\n");
+  usl.replace(usl.find("update: musl"), 12, "update: usl");
+  const Ringing usl_scaled = Ring(usl, 1.0);
+  std::string usl_text = WithTopLevel("");
+  usl_text.replace(usl_text.find("update: musl"), 12, "update: usl");
+  const Ringing usl_plain = Ring(usl_text, 0.5);
+  std::printf("ringing column, USL: period ratio %.4f, amplitude ratio %.4f\n",
+              usl_scaled.period / usl_plain.period, usl_scaled.amplitude / usl_plain.amplitude);
+  EXPECT_NEAR(usl_scaled.period / usl_plain.period, 2.0, 0.02 * 2.0);
+  EXPECT_NEAR(usl_scaled.amplitude / usl_plain.amplitude, 1.0, 0.02);
+}
+
+// A slow quasi-static load: gravity ramped over 1 s (seed App. B.2.3) with local damping 0.7, to
+// t = 1.6 s. Mass scaling by 9 until 1.4 s takes 3x fewer steps over that phase (sqrt(9), (6.31))
+// and ends in the same geostatic state: sigma_v = rho g d within 2.5 %, K0 = 0.5, and the unscaled
+// state's sigma_v within 1 % of rho g H (RMS over particles; 3 % at every particle: the wall
+// layers differ most). The floor reaction, logged on the scaled inertia, carries the unscaled
+// weight (it would be 1/9 of it if the reaction missed the factor). After `until` the run is
+// unscaled again (the time step shrinks back). With beta = 25 the column's period (0.47 s) is no
+// longer short against the 1 s ramp: at 1.4 s it still swings by 4 % of its weight (the manual's
+// warning that a large beta changes the result; docs/antilocking.md).
+TEST(MassScalingTest, SlowLoadInFewerStepsToTheSameGeostaticState) {
+  constexpr Real kUntil = 1.4, kEnd = 1.6;
+  struct Run {
+    ColumnState state;
+    size_t scaled_phase_steps = 0;  // steps that ended at t <= kUntil
+    Real late_dt = 0;               // a time step after kUntil [s]
+    Real floor_force = 0;           // floor reaction over the weight, mean of the last 0.25 s
+                                    // before kUntil
+  };
+  const auto run = [&](const std::string& extra) {
+    LoadedScene scene = LoadSceneFromString(
+        WithTopLevel("gravity_ramp: 1.0\ndamping: {local: 0.7}\n" + extra), "slow_column.yaml");
+    std::unordered_map<int64_t, Real> depth;
+    for (size_t p = 0; p < scene.state.particles.size(); ++p)
+      depth[scene.state.particles.id[p]] = kH - scene.state.particles.x[p].y();
+    Run r;
+    Real weight = 0, floor_sum = 0;
+    int floor_n = 0;
+    for (Real m : scene.state.particles.mass) weight += m * kG;
+    testing::RunUntil(scene, kEnd, [&](const State& s, const StepReport& rep) {
+      if (s.time <= kUntil) {
+        ++r.scaled_phase_steps;
+        // The reaction is the force on the scaled inertia: at rest it carries the unscaled weight
+        // (the material pushes the floor down: -y).
+        if (s.time > kUntil - 0.25) {
+          floor_sum += -rep.walls.force[int(Face::kYMin)].y() / weight;
+          ++floor_n;
+        }
+      }
+      if (s.time > kUntil + 0.05 && r.late_dt == 0) r.late_dt = s.dt;
+    });
+    r.state = Measure(scene.state, depth);
+    r.floor_force = floor_sum / floor_n;
+    return r;
+  };
+  const Run plain = run("");
+  const Run scaled = run("mass_scaling: {factor: 9, until: 1.4}\n");
+  Real diff = 0, diff2 = 0;  // max and RMS over particles of |d sigma_v| / (rho g H)
+  for (const auto& [id, sv] : plain.state.sigma_v) {
+    const Real d = std::abs(scaled.state.sigma_v.at(id) - sv) / (kRho * kG * kH);
+    diff = std::max(diff, d);
+    diff2 += d * d;
+  }
+  const Real diff_rms = std::sqrt(diff2 / Real(plain.state.sigma_v.size()));
+  const Real ratio = Real(scaled.scaled_phase_steps) / Real(plain.scaled_phase_steps);
+  std::printf("slow load: steps to 1.4 s %zu -> %zu (ratio %.4f); at 1.6 s RMS(sigma_v - rho g d) "
+              "%.3f %% -> %.3f %%, K0 %.4f -> %.4f, |d sigma_v| / (rho g H) RMS %.3f %%, max %.3f %%; dt after "
+              "until %.4g -> %.4g s\n",
+              plain.scaled_phase_steps, scaled.scaled_phase_steps, ratio,
+              100 * plain.state.rms_error, 100 * scaled.state.rms_error, plain.state.k0,
+              scaled.state.k0, 100 * diff_rms, 100 * diff, plain.late_dt, scaled.late_dt);
+  std::printf("floor reaction / weight, mean over the 0.25 s before until: %.5f -> %.5f\n",
+              plain.floor_force, scaled.floor_force);
+  EXPECT_NEAR(scaled.floor_force, 1.0, 0.02);  // the scaled column still swings by +-2 %
+  EXPECT_NEAR(ratio, 1.0 / 3.0, 0.03);
+  EXPECT_LT(plain.state.rms_error, 0.025);
+  EXPECT_LT(scaled.state.rms_error, 0.025);
+  EXPECT_NEAR(scaled.state.k0, 0.5, 0.05);
+  EXPECT_LT(diff_rms, 0.01);
+  EXPECT_LT(diff, 0.03);
+  EXPECT_NEAR(scaled.late_dt / plain.late_dt, 1.0, 0.05) << "after until the time step is unscaled";
 }
 
 }  // namespace

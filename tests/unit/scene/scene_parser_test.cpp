@@ -861,6 +861,27 @@ TEST(SceneParserTest, DampingKeys) {
   EXPECT_EQ(always.model.damping.At(1e9), 0.1);
 }
 
+TEST(SceneParserTest, MassScalingKeys) {
+  // mass_scaling: {factor, until} at the top level (line 12, appended).
+  ExpectError(kBase3 + "mass_scaling: {factor: 0.5}\n", 12, "mass_scaling.factor", "must be >= 1 [-]");
+  ExpectError(kBase3 + "mass_scaling: {until: 2}\n", 12, "mass_scaling.factor",
+              "missing required key 'factor'");
+  ExpectError(kBase3 + "mass_scaling: {factor: 10, until: -1}\n", 12, "mass_scaling.until",
+              "must be > 0 [s]");
+  ExpectError(kBase3 + "mass_scaling: {factor: 10, beta: 2}\n", 12, "mass_scaling.beta",
+              "unknown key 'beta'");
+  ExpectError(kBase3 + "mass_scaling: 10\n", 12, "mass_scaling", "expected a map");
+  const LoadedScene off = LoadSceneFromString(kBase3, "ok.yaml");
+  EXPECT_EQ(off.model.mass_scaling.factor, 1);
+  EXPECT_EQ(off.resolved_yaml.find("mass_scaling"), std::string::npos) << off.resolved_yaml;
+  const LoadedScene on = LoadSceneFromString(kBase3 + "mass_scaling: {factor: 25, until: 0.5}\n", "ok.yaml");
+  EXPECT_EQ(on.model.mass_scaling.At(0.49), 25);
+  EXPECT_EQ(on.model.mass_scaling.At(0.5), 1);
+  const LoadedScene again = LoadSceneFromString(on.resolved_yaml, "again.yaml");
+  EXPECT_EQ(again.model.mass_scaling.factor, 25);
+  EXPECT_EQ(again.model.mass_scaling.until, 0.5);
+}
+
 TEST(SceneParserTest, BulkViscosityKeys) {
   const std::string steel =
       "{model: linear_elastic, density: 7800, youngs_modulus: 2.0e11, poisson_ratio: 0.3, ";
