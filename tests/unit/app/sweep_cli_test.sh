@@ -72,14 +72,16 @@ fi
 exec 9>&-
 
 # A sweep killed hard (SIGKILL) leaves its cases running; they hold the lock until they end.
+# The case must outlive the kill and the next sweep's start: 8 s of two_disks take about 1.2 s
+# (1.5 s took 0.2 s and sometimes ended first, so the check raced).
 cat > "$work/slow.yaml" <<YAML
 base: $src/scenes/two_disks_2d.yaml
 parameters:
-  time.end: [1.5]
+  time.end: [8]
 YAML
 "$surge" sweep "$work/slow.yaml" --out "$work/slow" >/dev/null 2>&1 &
 spid=$!
-for _ in $(seq 50); do [ -s "$work/slow/case_000_end=1.5/log.txt" ] && break; sleep 0.1; done
+for _ in $(seq 50); do [ -s "$work/slow/case_000_end=8/log.txt" ] && break; sleep 0.1; done
 kill -9 "$spid"; wait "$spid" 2>/dev/null
 expect lock_orphans 1 'cases left running by one that was killed' -- "$surge" sweep "$work/slow.yaml" --out "$work/slow"
 for _ in $(seq 100); do pgrep -f "run $src/scenes/two_disks_2d.yaml --out $work/slow" >/dev/null || break; sleep 0.1; done
