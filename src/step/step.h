@@ -39,7 +39,8 @@ Pipeline MakePipeline(const Model& model);
 
 // Time step for the next step: CFL rule dt = C dx / max_p (c_p + |v_p|) (spec §1.7) and the
 // viscous limit (ViscousTimeStep), bounded by max_dt, the fixed override and the remaining time
-// to Model::time.end.
+// to Model::time.end. Within 10 CFL steps of the end the rest is split into equal steps (no
+// sliver last step, whose wall and obstacle reactions m v_n / dt would be far too large).
 Real NextTimeStep(const Model& model, const State& state);
 
 // Viscous (diffusion) limit of the explicit step over the materials that have particles:
