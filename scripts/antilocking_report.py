@@ -42,7 +42,8 @@ OPTIONS = [  # label, antilocking map
     ("smoothing", "{method: smoothing}"),
     ("smoothing total", "{method: smoothing, strain: total}"),
 ]
-SCENE = "scenes/dam_break_barrier_2d.yaml"
+SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes",
+                     "dam_break_barrier_2d.yaml")
 RHO, G = 997.5, 9.81
 
 

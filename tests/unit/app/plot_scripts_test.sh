@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The plot scripts (scripts/plot_forces.py, scripts/plot_sweep.py) on small data (ctest label
+# The plot scripts (scripts/plot_forces.py, scripts/plot_sweep.py, scripts/antilocking_report.py)
+# on small data (ctest label
 # unit): the 2 x 2 tiny sweep of tests/data/sweeps/tiny_product.yaml (a 2-D block towards a
 # post, well under a second a case) gives a sweep.csv, results and summary.json files; each
 # plot mode must write a non-empty PNG, and a bad column must fail with a message naming it.
@@ -33,6 +34,17 @@ png plot_forces_analysis_default_name "${h5%.h5}_analysis.png" -- "$py" "$src/sc
 png plot_sweep "$work/s.png" -- "$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --x w --y v --out "$work/s.png"
 png plot_sweep_default_name "$work/tiny/sweep.png" -- "$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --x v --y w --quantities f_pk analysis.impulse
 png plot_sweep_histories "$work/h.png" -- "$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --histories --match "w=0.2" --out "$work/h.png"
+
+# The anti-locking comparison (scripts/antilocking_report.py) on a coarse, short dam break with
+# barrier: eight runs, a CSV row each, both PNGs.
+png antilocking_report "$work/al/plots/antilocking_barrier_pressure.png" -- "$py" "$src/scripts/antilocking_report.py" \
+  --surge "$surge" --out "$work/al" --plots "$work/al/plots" --end 0.6 --set grid.cell_size=0.5 \
+  --set bodies.0.particles_per_cell=2
+if [ -s "$work/al/plots/antilocking_barrier_force.png" ] && [ "$(wc -l < "$work/al/antilocking_report.csv")" = 9 ]; then
+  ok antilocking_report_table
+else
+  bad "antilocking_report_table: $(cat "$work/al/antilocking_report.csv" 2>&1 | head -3)"
+fi
 
 out=$("$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --x width --y v 2>&1)
 if [ $? -ne 0 ] && grep -q "no column 'width'" <<<"$out"; then ok plot_sweep_bad_column; else bad "plot_sweep_bad_column: $out"; fi
