@@ -101,6 +101,30 @@ TEST(AntilockingTest, NodeBasedUnlocksTheIncompressibleCantilever) {
   EXPECT_NEAR(node.amplitude_ratio, 1.0, 0.03);
 }
 
+// Particle pressures -tr(sigma)/3 summed by id over the sampled steps, and each particle's last
+// height, for the RMS of the time-averaged pressure about rho g (h - y).
+struct PressureSamples {
+  std::map<int64_t, std::pair<Real, int>> pressure;  // by id: sum of samples, count
+  std::map<int64_t, Real> height;                    // by id: last y [m]
+  void Add(const Particles& P) {
+    for (size_t p = 0; p < P.size(); ++p) {
+      auto& [sum, n] = pressure[P.id[p]];
+      sum += -P.stress[p].trace() / 3;
+      ++n;
+      height[P.id[p]] = P.x[p].y();
+    }
+  }
+  // RMS over particles of p - rho g (h - y), relative to rho g h.
+  Real RmsAboutHydrostatic(Real rho, Real g, Real h) const {
+    Real sq = 0;
+    for (const auto& [id, acc] : pressure) {
+      const Real dev = acc.first / acc.second - rho * g * (h - height.at(id));
+      sq += dev * dev;
+    }
+    return std::sqrt(sq / Real(pressure.size())) / (rho * g * h);
+  }
+};
+
 // Water at rest in a tank: scenes/dam_break_2d.yaml with the column filling a 0.114 m wide box to
 // h = 0.057 m (0.0095 m cells, 2 particles per cell per direction), gravity ramped over 0.2 s
 // (seed App. B.2.3) and the state observed after settling. Returns the RMS over particles (their
@@ -116,33 +140,21 @@ Real TankPressureRms(const std::string& method) {
   Real mass = 0;
   for (Real m : scene.state.particles.mass) mass += m;
   const Real h = mass / (kRho * kW);
-  std::map<int64_t, std::pair<Real, int>> pressure;  // by particle id: sum of samples, count
-  std::map<int64_t, Real> height;
+  PressureSamples samples;
   std::vector<Real> floor;  // floor reaction per step [N/m]
   testing::RunUntil(scene, kEnd, [&](const State& s, const StepReport& r) {
     if (s.time < kAvgFrom) return;
     floor.push_back(-r.walls.force[int(Face::kYMin)].y());
-    const Particles& P = s.particles;
-    for (size_t p = 0; p < P.size(); ++p) {
-      auto& [sum, n] = pressure[P.id[p]];
-      sum += -P.stress[p].trace() / 3;
-      ++n;
-      height[P.id[p]] = P.x[p].y();
-    }
+    samples.Add(s.particles);
   });
-  Real sq = 0;
-  for (const auto& [id, acc] : pressure) {
-    const Real dev = acc.first / acc.second - kRho * kG * (h - height[id]);
-    sq += dev * dev;
-  }
-  const Real rms = std::sqrt(sq / Real(pressure.size())) / (kRho * kG * h);
+  const Real rms = samples.RmsAboutHydrostatic(kRho, kG, h);
   // Wall-force noise: RMS fluctuation of the floor reaction about the weight m g, per weight.
   Real noise = 0;
   for (Real f : floor) noise += (f - mass * kG) * (f - mass * kG);
   noise = std::sqrt(noise / Real(floor.size())) / (mass * kG);
   std::printf("tank at rest, antilocking %-5s: RMS(p - rho g depth) / rho g h = %.4f (%zu "
               "particles); floor force RMS(R - m g) / m g = %.2e\n",
-              method.c_str(), rms, pressure.size(), noise);
+              method.c_str(), rms, samples.pressure.size(), noise);
   EXPECT_LT(noise, 0.02) << "the floor must carry the weight";
   return rms;
 }
@@ -247,29 +259,17 @@ Real BarrierPressureRms(const std::string& antilocking) {
   const Real h = mass / (kRho * kFloor);
   testing::RunUntil(scene, kImpact, [](const State&, const StepReport&) {});
   scene.model.damping = LocalDamping{0.7, kSettled};
-  std::map<int64_t, std::pair<Real, int>> pressure;  // by particle id: sum of samples, count
-  std::map<int64_t, Real> height;
+  PressureSamples samples;
   Real vmax = 0;
   testing::RunUntil(scene, kEnd, [&](const State& s, const StepReport&) {
     if (s.time < kSettled) return;
-    const Particles& P = s.particles;
-    for (size_t p = 0; p < P.size(); ++p) {
-      auto& [sum, n] = pressure[P.id[p]];
-      sum += -P.stress[p].trace() / 3;
-      ++n;
-      height[P.id[p]] = P.x[p].y();
-      vmax = std::max(vmax, P.v[p].norm());
-    }
+    samples.Add(s.particles);
+    for (const Vec3& v : s.particles.v) vmax = std::max(vmax, v.norm());
   });
-  Real sq = 0;
-  for (const auto& [id, acc] : pressure) {
-    const Real dev = acc.first / acc.second - kRho * kG * (h - height[id]);
-    sq += dev * dev;
-  }
-  const Real rms = std::sqrt(sq / Real(pressure.size())) / (kRho * kG * h);
+  const Real rms = samples.RmsAboutHydrostatic(kRho, kG, h);
   std::printf("dam break with barrier after the impact, antilocking {%s}: RMS(p - rho g depth) / rho g h "
               "= %.4f (%zu particles, h = %.3f m, max |v| after release %.2e m/s)\n",
-              antilocking.c_str(), rms, pressure.size(), h, vmax);
+              antilocking.c_str(), rms, samples.pressure.size(), h, vmax);
   return rms;
 }
 
