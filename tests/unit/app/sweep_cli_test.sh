@@ -84,7 +84,8 @@ spid=$!
 for _ in $(seq 50); do [ -s "$work/slow/case_000_end=8/log.txt" ] && break; sleep 0.1; done
 kill -9 "$spid"; wait "$spid" 2>/dev/null
 expect lock_orphans 1 'cases left running by one that was killed' -- "$surge" sweep "$work/slow.yaml" --out "$work/slow"
-for _ in $(seq 100); do pgrep -f "run $src/scenes/two_disks_2d.yaml --out $work/slow" >/dev/null || break; sleep 0.1; done
+# Wait for the orphaned case to end (about 1 s in Release; several times that under sanitizers).
+for _ in $(seq 1200); do pgrep -f "run $src/scenes/two_disks_2d.yaml --out $work/slow" >/dev/null || break; sleep 0.1; done
 expect lock_released 0 '1 cases, 0 to run \(1 completed before\)' -- "$surge" sweep "$work/slow.yaml" --out "$work/slow"
 
 # A sweep stopped with Ctrl-C (SIGINT to the sweep): its case writes a checkpoint and ends
