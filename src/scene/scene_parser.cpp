@@ -599,14 +599,9 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
              "strain smoothing (Anura3D manual §6.7) smooths the volumetric strain only: approach "
              "volumetric (or leave it out)");
       }
-      if (full && *m.antilocking == AntiLockingMethod::kNode) {
-        Fail(a, Child(ap, "approach"),
-             "the node-based full-tensor approximation is not implemented: use method cell or "
-             "hybrid with approach " + a.Scalar() + ", or method node with approach volumetric");
-      }
       if (full && *m.antilocking == AntiLockingMethod::kNone) {
         Fail(a, Child(ap, "approach"), "approach " + a.Scalar() +
-                                           " needs a control volume: method cell or hybrid");
+                                           " needs a control volume: method node, cell or hybrid");
       }
     }
     // Anura3D smooths the strain rate (manual (6.34)-(6.37)): the increment by default.

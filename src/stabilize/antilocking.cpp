@@ -253,14 +253,16 @@ Eigen::Matrix<Real, kDim, 1> CellXi(const Vec3& x, Real inv_dx, Vec3i& cell) {
   return xi;
 }
 
-// Weighted least-squares fit over one cell, from its moment sums `a` (Filtered::kMoments), at the
-// particle position xi: the linear components a + b.(xi - c) with the mass centroid c as origin
+// Weighted least-squares fit over one control volume (a cell, or a node's support), from its
+// moment sums `a` (Filtered::kMoments), at the position xi (min_trace, min_det: the singularity
+// test below): the linear components a + b.(xi - c) with the mass centroid c as origin
 // (spec §3.3 [REC]), the normal equations in centred form C b = sum w (xi - c) q / sum w,
 // C = sum w (xi - c)(xi - c)^T / sum w; the constant components the weighted mean. When C is
 // singular (the cell's particles on a plane or a line, a body entering a cell) every component
-// falls back to the constant approximation for this cell and step (seed §4.4.6).
+// falls back to the constant approximation for this control volume and step (seed §4.4.6).
 template <int kDim>
-Filtered<kDim> CellFit(const Real* a, const Eigen::Matrix<Real, kDim, 1>& xi, bool* linear_out) {
+Filtered<kDim> CellFit(const Real* a, const Eigen::Matrix<Real, kDim, 1>& xi, bool* linear_out,
+                       Real min_trace = 1e-8, Real min_det = 1e-10) {
   using F = Filtered<kDim>;
   using VecD = Eigen::Matrix<Real, kDim, 1>;
   using MatD = Eigen::Matrix<Real, kDim, kDim>;
@@ -272,8 +274,10 @@ Filtered<kDim> CellFit(const Real* a, const Eigen::Matrix<Real, kDim, 1>& xi, bo
   for (int d = 0; d < kDim; ++d)
     for (int e = d; e < kDim; ++e, ++k) C(d, e) = C(e, d) = a[k] / s0 - c[d] * c[e];
   const Real tr = C.trace();
-  // Relative singularity test: det C against (tr C / dim)^dim, 1 for an isotropic spread.
-  const bool linear = tr > 0 && C.determinant() > 1e-10 * std::pow(tr / kDim, kDim);
+  // Singularity test: the spread must exceed round-off (tr C > 1e-8 cell^2, an RMS spread of
+  // 1e-4 cells; one particle leaves C = O(1e-16) of either sign) and det C must not be small
+  // against (tr C / dim)^dim, 1 for an isotropic spread.
+  const bool linear = tr > min_trace && C.determinant() > min_det * std::pow(tr / kDim, kDim);
   if (linear_out) *linear_out = linear;
   const MatD Cinv = linear ? MatD(C.inverse()) : MatD::Zero();
   F out;
@@ -346,6 +350,42 @@ Mat3 ProjectedIncrement(const Mat3& f, const Mat3& eps_h, const Mat3& inv_stretc
   }
 }
 
+// Adds one particle's weighted moments (weight w at position xi, components f) to the sums `a`
+// (layout of Filtered::kMoments).
+template <int kDim>
+void AddMoments(Real* a, Real w, const Eigen::Matrix<Real, kDim, 1>& xi, const Filtered<kDim>& f) {
+  using F = Filtered<kDim>;
+  int j = 0;
+  a[j++] += w;
+  for (int d = 0; d < kDim; ++d) a[j++] += w * xi[d];
+  for (int d = 0; d < kDim; ++d)
+    for (int e = d; e < kDim; ++e) a[j++] += w * xi[d] * xi[e];
+  for (int l = 0; l < F::kLinear; ++l) {
+    a[j++] += w * f.q[l];
+    for (int d = 0; d < kDim; ++d) a[j++] += w * xi[d] * f.q[l];
+  }
+  for (int l = 0; l < F::kConst; ++l) a[j++] += w * f.q[F::kLinear + l];
+}
+
+// Flushes a block's padded moment buffer into the grid slots (stride kMoments).
+template <int kDim, class K>
+void FlushMoments(const SparseGrid& grid, size_t blk, const std::vector<Real>& buf,
+                  AntiLockingScratch& s) {
+  using Pad = BlockPad<kDim, K>;
+  constexpr int M = Filtered<kDim>::kMoments;
+  for (int a = 0; a < Pad::E; ++a)
+    for (int b = 0; b < Pad::E; ++b)
+      for (int c = 0; c < Pad::Ez; ++c) {
+        const Real* n = &buf[size_t(Pad::Index(a, b, c)) * M];
+        if (n[0] == 0) continue;
+        const long g = PaddedToGrid(grid, blk, a, b, c);
+        SURGE_ASSERT(g >= 0);
+        if (g < 0) continue;
+        Real* out = &s.moments[size_t(g) * M];
+        for (int j = 0; j < M; ++j) out[j] += n[j];
+      }
+}
+
 // Cell moment sums of one block's particles of [begin, end) into the grid slots of the cells'
 // lower-corner nodes (scratch.moments, stride kMoments), through the padded block buffer as in
 // ScatterBlock (fixed order: particle order, then colour order).
@@ -366,37 +406,52 @@ void ScatterCellMoments(const StepContext& ctx, const Particles& P, const std::v
     Vec3i cell;
     const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
     const Vec3i lc = cell - origin;
-    Real* a = &buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M];
-    const F f = F::Of(s.trial_eps[p]);
-    const Real m = P.mass[p];
-    int j = 0;
-    a[j++] += m;
-    for (int d = 0; d < kDim; ++d) a[j++] += m * xi[d];
-    for (int d = 0; d < kDim; ++d)
-      for (int e = d; e < kDim; ++e) a[j++] += m * xi[d] * xi[e];
-    for (int l = 0; l < F::kLinear; ++l) {
-      a[j++] += m * f.q[l];
-      for (int d = 0; d < kDim; ++d) a[j++] += m * xi[d] * f.q[l];
-    }
-    for (int l = 0; l < F::kConst; ++l) a[j++] += m * f.q[F::kLinear + l];
+    AddMoments<kDim>(&buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M], P.mass[p], xi,
+                     F::Of(s.trial_eps[p]));
   }
-  if (!any) return;
-  for (int a = 0; a < Pad::E; ++a)
-    for (int b = 0; b < Pad::E; ++b)
-      for (int c = 0; c < Pad::Ez; ++c) {
-        const Real* n = &buf[size_t(Pad::Index(a, b, c)) * M];
-        if (n[0] == 0) continue;
-        const long g = PaddedToGrid(grid, blk, a, b, c);
-        SURGE_ASSERT(g >= 0);
-        if (g < 0) continue;
-        Real* out = &s.moments[size_t(g) * M];
-        for (int j = 0; j < M; ++j) out[j] += n[j];
-      }
+  if (any) FlushMoments<kDim, K>(grid, blk, buf, s);
 }
 
-// AS2 / AS3CV on cell-based control volumes, or the hybrid (trace from node-based AS1, deviator
-// from cell-based AS2), on the trial strain of one material group; replaces L_p by
-// (f-bar_p - I)/dt (seed Table 4.1 steps 2-4, (4.25)-(4.27), (4.33)-(4.34), (4.40)).
+// Node moment sums (seed (4.29)_1 with H_i = sum S^T S N_ip m_p): every particle of the group adds
+// to each node of its stencil with weight N_ip m_p, at xi = (x_p - x_i)/dx (node-centred, cell
+// units); padded block buffer and fixed order as ScatterBlock.
+template <int kDim, class K>
+void ScatterNodeMoments(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                        size_t begin, size_t end, const SparseGrid& grid, size_t blk,
+                        std::vector<Real>& buf, AntiLockingScratch& s) {
+  using Pad = BlockPad<kDim, K>;
+  using F = Filtered<kDim>;
+  constexpr int M = F::kMoments;
+  buf.assign(size_t(Pad::kSize) * M, 0.0);
+  const Vec3i origin = grid.block_origin[blk];
+  bool any = false;
+  for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
+    const uint32_t p = grid.sorted[k];
+    if (p < begin || p >= end || !s.trial_ok[p]) continue;
+    any = true;
+    Stencil<kDim, K> st;
+    st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
+    const Vec3i lb = st.base - origin;
+    const F f = F::Of(s.trial_eps[p]);
+    for (int i = 0; i < st.W; ++i)
+      for (int j = 0; j < st.W; ++j)
+        for (int c = 0; c < st.Wz; ++c) {
+          const Real w = st.Weight(i, j, c);
+          if (w == 0) continue;
+          const int idx[3] = {i, j, c};
+          Eigen::Matrix<Real, kDim, 1> xi;
+          for (int d = 0; d < kDim; ++d) xi[d] = x_n[p][d] * ctx.inv_dx - (st.base[d] + idx[d]);
+          AddMoments<kDim>(&buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * M],
+                           w * P.mass[p], xi, f);
+        }
+  }
+  if (any) FlushMoments<kDim, K>(grid, blk, buf, s);
+}
+
+// AS2 / AS3CV on cell- or node-based control volumes, or the hybrid (trace from node-based AS1,
+// deviator from cell-based AS2), on the trial strain of one material group; replaces L_p by
+// (f-bar_p - I)/dt (seed Table 4.1 steps 2-4, (4.25)-(4.27), (4.29)-(4.32), (4.33)-(4.34),
+// (4.40)).
 template <int kDim, class K>
 void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
                        size_t begin, size_t end, const SparseGrid& grid, const Mode& mode,
@@ -426,14 +481,68 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
     const auto keep = [&](size_t p, Real theta_bar) { s.theta_bar[p] = theta_bar; };
     Project<kDim, K, true>(ctx, P, x_n, begin, end, grid, s, theta, keep);
   }
-  // Cell moments (4.25)_1 with H_c = sum S^T S m, colour-phased as every scatter.
+  // Cell moments (4.25)_1 with H_c = sum S^T S m, or node moments (4.29)_1, colour-phased as
+  // every scatter.
+  const bool node = al.method == AntiLockingMethod::kNode;
+  const bool constant_trace = al.approach == AntiLockingApproach::kConstantVolumetric;
   s.moments.assign(grid.block_count() * kBlockNodes * size_t(M), 0.0);
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
     ParallelFor(blocks.size(), 1, [&](size_t i) {
       thread_local std::vector<Real> buf;
-      ScatterCellMoments<kDim, K>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+      if (node) {
+        ScatterNodeMoments<kDim, K>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+      } else {
+        ScatterCellMoments<kDim, K>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+      }
     });
+  }
+  if (node) {
+    // Node-based: the nodal values eps-hat_i = S(xi_i) alpha_i (4.31)_1, the support's fit at the
+    // node itself (xi = 0 in node-centred coordinates); AS3CV takes the trace's weighted mean.
+    // Then eps^h_p = M* sum_i N_ip eps-hat_i (4.32)_1.
+    constexpr int Q = F::kLinear + F::kConst;
+    s.node_fit.assign(grid.block_count() * kBlockNodes * size_t(Q), 0.0);
+    ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+      for (int l = 0; l < kBlockNodes; ++l) {
+        const size_t g = blk * kBlockNodes + size_t(l);
+        const Real* a = &s.moments[g * M];
+        if (a[0] == 0) continue;
+        // A node's fit is evaluated at the node, which can lie outside its particles (a free
+        // surface, the outer nodes of a B-spline stencil): extrapolating a thin support's slopes
+        // made the water tank blow up within 0.3 s with the cell criteria (1e-8, 1e-10). A node
+        // takes the linear fit only when its particles spread over tr C > 0.05 cell^2 (an RMS
+        // spread of about 0.13 cells per axis) with det C > 1e-3 (tr C / dim)^dim.
+        F fit = CellFit<kDim>(a, Eigen::Matrix<Real, kDim, 1>::Zero(), nullptr, 0.05, 1e-3);
+        if (constant_trace) fit.q[0] = a[1 + kDim + F::kSym] / a[0];  // AS3CV (4.23)
+        for (int q = 0; q < Q; ++q) s.node_fit[g * Q + size_t(q)] = fit.q[q];
+      }
+    });
+    ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+      const Vec3i origin = grid.block_origin[blk];
+      for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
+        const uint32_t p = grid.sorted[k];
+        if (p < begin || p >= end || !s.trial_ok[p]) continue;
+        Stencil<kDim, K> st;
+        st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
+        const Vec3i lb = st.base - origin;
+        F sum;
+        sum.q.fill(0);
+        for (int i = 0; i < st.W; ++i)
+          for (int j = 0; j < st.W; ++j)
+            for (int c = 0; c < st.Wz; ++c) {
+              const Real w = st.Weight(i, j, c);
+              if (w == 0) continue;
+              const long g = PaddedToGrid(grid, blk, lb.x() + i, lb.y() + j, lb.z() + c);
+              SURGE_ASSERT(g >= 0);
+              for (int q = 0; q < Q; ++q) sum.q[q] += w * s.node_fit[size_t(g) * Q + size_t(q)];
+            }
+        const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
+        const Mat3 f_bar = ProjectedIncrement<kDim>(f, sum.Tensor(s.trial_eps[p]), s.inv_stretch[p]);
+        if (f_bar.allFinite()) L[p] = (f_bar - Mat3::Identity()) / ctx.dt;
+      }
+    });
+    return;
   }
   // Steps 3-4: eps^h_p = M* S_p alpha_c (4.27), or for the hybrid M*_vol theta-bar_p +
   // M*_dev S_p alpha_c (4.34); then f-bar_p and L_p.
@@ -453,7 +562,7 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
       if (hybrid) {
         if (!std::isfinite(s.theta_bar[p])) continue;  // left to CheckState
         fit.q[0] = s.theta_bar[p];
-      } else if (al.approach == AntiLockingApproach::kConstantVolumetric) {
+      } else if (constant_trace) {
         fit.q[0] = a[1 + kDim + F::kSym] / a[0];  // AS3CV: the trace constant (4.23)
       }
       const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
@@ -573,8 +682,6 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
       continue;
     }
     if (method == AntiLockingMethod::kHybrid || al.approach != AntiLockingApproach::kVolumetric) {
-      SURGE_CHECK(method != AntiLockingMethod::kNode,
-                  "node-based full-tensor anti-locking is not implemented (the parser refuses it)");
       DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
         ProjectFullTensor<kDim, K>(ctx, particles, x_n, g.begin, g.end, grid, mode, al, scratch, L);
       });

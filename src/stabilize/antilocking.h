@@ -22,7 +22,9 @@ struct AntiLockingScratch {
   std::vector<Mat3> inv_stretch;  // (b^tr)^(-1/2)
   std::vector<char> trial_ok;     // b^tr positive definite
   std::vector<Real> theta_bar;    // hybrid: node-projected trace                    (4.34)_1
-  std::vector<Real> moments;      // cell moment sums, per grid slot of the cell's lower corner
+  std::vector<Real> moments;      // cell (or node) moment sums, per grid slot of the cell's lower
+                                  // corner (or of the node)
+  std::vector<Real> node_fit;     // node-based: the fitted components at each node   (4.31)_1
   // Strain smoothing (Anura3D §6.7) only: per node, the sum and count of the cell values around it.
   std::vector<Real> node_sum;    // (6.35)
   std::vector<Real> node_count;

@@ -761,12 +761,10 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
               "materials.steel.antilocking.method", "expected one of: none, node, cell, hybrid, smoothing");
   ExpectError(WithMaterial(steel + "antilocking: {approach: volumetric}}"), 7,
               "materials.steel.antilocking.method", "missing required key 'method'");
-  ExpectError(WithMaterial(steel + "antilocking: {method: node, approach: volumetric_deviatoric}}"),
-              7, "materials.steel.antilocking.approach", "node-based full-tensor approximation is not implemented");
   ExpectError(WithMaterial(steel + "antilocking: {method: hybrid, approach: constant_volumetric}}"),
               7, "materials.steel.antilocking.approach", "approach volumetric_deviatoric");
   ExpectError(WithMaterial(steel + "antilocking: {method: none, approach: constant_volumetric}}"),
-              7, "materials.steel.antilocking.approach", "needs a control volume");
+              7, "materials.steel.antilocking.approach", "needs a control volume: method node, cell or hybrid");
   ExpectError(WithMaterial(steel + "antilocking: {method: cell, approach: as2}}"), 7,
               "materials.steel.antilocking.approach",
               "expected one of: volumetric, volumetric_deviatoric, constant_volumetric");
@@ -794,6 +792,9 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
     EXPECT_EQ(as3.model.antilocking[0].approach, AntiLockingApproach::kConstantVolumetric);
     EXPECT_EQ(LoadSceneFromString(as3.resolved_yaml, "again.yaml").model.antilocking[0].approach,
               AntiLockingApproach::kConstantVolumetric);
+    const LoadedScene nb = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: node, approach: volumetric_deviatoric}}"), "ok.yaml");
+    EXPECT_EQ(nb.model.antilocking[0].approach, AntiLockingApproach::kVolumetricDeviatoric);
     const LoadedScene hb = LoadSceneFromString(
         WithMaterial(steel + "antilocking: {method: hybrid}}"), "ok.yaml");
     EXPECT_EQ(hb.model.antilocking[0].method, AntiLockingMethod::kHybrid);
