@@ -83,7 +83,7 @@ TEST(DeterminismTest, AntiLockedScenesAreBitwiseIdenticalForOneAndTwoThreads) {
   // The full-tensor approaches: hybrid (node trace, cell deviator) and AS3CV on the sand's trial
   // elastic strain; the cell moment scatter must keep the fixed order too.
   for (const char* al : {"{method: hybrid}", "{method: cell, approach: constant_volumetric}",
-                         "{method: smoothing}"}) {
+                         "{method: smoothing}", "{method: node, approach: volumetric_deviatoric}"}) {
     std::vector<std::string> full = sand;
     full.back() = std::string("materials.sand.antilocking=") + al;
     EXPECT_EQ(RunWithThreads("column_collapse_2d.yaml", full, 0.03, 1),
