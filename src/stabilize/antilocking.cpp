@@ -386,13 +386,15 @@ void FlushMoments(const SparseGrid& grid, size_t blk, const std::vector<Real>& b
       }
 }
 
-// Cell moment sums of one block's particles of [begin, end) into the grid slots of the cells'
-// lower-corner nodes (scratch.moments, stride kMoments), through the padded block buffer as in
-// ScatterBlock (fixed order: particle order, then colour order).
-template <int kDim, class K>
-void ScatterCellMoments(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
-                        size_t begin, size_t end, const SparseGrid& grid, size_t blk,
-                        std::vector<Real>& buf, AntiLockingScratch& s) {
+// Moment sums of one block's particles of [begin, end), through the padded block buffer as in
+// ScatterBlock (fixed order: particle order, then colour order), into scratch.moments (stride
+// kMoments). Cell-based (4.25)_1: weight m_p at xi = the position in the cell (CellXi), in the
+// slot of the cell's lower-corner node. Node-based (4.29)_1 with H_i = sum S^T S N_ip m_p: weight
+// N_ip m_p at every node of the stencil, at xi = (x_p - x_i)/dx (node-centred, cell units).
+template <int kDim, class K, bool kNode>
+void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                    size_t begin, size_t end, const SparseGrid& grid, size_t blk,
+                    std::vector<Real>& buf, AntiLockingScratch& s) {
   using Pad = BlockPad<kDim, K>;
   using F = Filtered<kDim>;
   constexpr int M = F::kMoments;
@@ -403,47 +405,28 @@ void ScatterCellMoments(const StepContext& ctx, const Particles& P, const std::v
     const uint32_t p = grid.sorted[k];
     if (p < begin || p >= end || !s.trial_ok[p]) continue;
     any = true;
-    Vec3i cell;
-    const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
-    const Vec3i lc = cell - origin;
-    AddMoments<kDim>(&buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M], P.mass[p], xi,
-                     F::Of(s.trial_eps[p]));
-  }
-  if (any) FlushMoments<kDim, K>(grid, blk, buf, s);
-}
-
-// Node moment sums (seed (4.29)_1 with H_i = sum S^T S N_ip m_p): every particle of the group adds
-// to each node of its stencil with weight N_ip m_p, at xi = (x_p - x_i)/dx (node-centred, cell
-// units); padded block buffer and fixed order as ScatterBlock.
-template <int kDim, class K>
-void ScatterNodeMoments(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
-                        size_t begin, size_t end, const SparseGrid& grid, size_t blk,
-                        std::vector<Real>& buf, AntiLockingScratch& s) {
-  using Pad = BlockPad<kDim, K>;
-  using F = Filtered<kDim>;
-  constexpr int M = F::kMoments;
-  buf.assign(size_t(Pad::kSize) * M, 0.0);
-  const Vec3i origin = grid.block_origin[blk];
-  bool any = false;
-  for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
-    const uint32_t p = grid.sorted[k];
-    if (p < begin || p >= end || !s.trial_ok[p]) continue;
-    any = true;
-    Stencil<kDim, K> st;
-    st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
-    const Vec3i lb = st.base - origin;
     const F f = F::Of(s.trial_eps[p]);
-    for (int i = 0; i < st.W; ++i)
-      for (int j = 0; j < st.W; ++j)
-        for (int c = 0; c < st.Wz; ++c) {
-          const Real w = st.Weight(i, j, c);
-          if (w == 0) continue;
-          const int idx[3] = {i, j, c};
-          Eigen::Matrix<Real, kDim, 1> xi;
-          for (int d = 0; d < kDim; ++d) xi[d] = x_n[p][d] * ctx.inv_dx - (st.base[d] + idx[d]);
-          AddMoments<kDim>(&buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * M],
-                           w * P.mass[p], xi, f);
-        }
+    if constexpr (kNode) {
+      Stencil<kDim, K> st;
+      st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
+      const Vec3i lb = st.base - origin;
+      for (int i = 0; i < st.W; ++i)
+        for (int j = 0; j < st.W; ++j)
+          for (int c = 0; c < st.Wz; ++c) {
+            const Real w = st.Weight(i, j, c);
+            if (w == 0) continue;
+            const int idx[3] = {i, j, c};
+            Eigen::Matrix<Real, kDim, 1> xi;
+            for (int d = 0; d < kDim; ++d) xi[d] = x_n[p][d] * ctx.inv_dx - (st.base[d] + idx[d]);
+            AddMoments<kDim>(&buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * M],
+                             w * P.mass[p], xi, f);
+          }
+    } else {
+      Vec3i cell;
+      const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
+      const Vec3i lc = cell - origin;
+      AddMoments<kDim>(&buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M], P.mass[p], xi, f);
+    }
   }
   if (any) FlushMoments<kDim, K>(grid, blk, buf, s);
 }
@@ -491,9 +474,9 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
     ParallelFor(blocks.size(), 1, [&](size_t i) {
       thread_local std::vector<Real> buf;
       if (node) {
-        ScatterNodeMoments<kDim, K>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+        ScatterMoments<kDim, K, true>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
       } else {
-        ScatterCellMoments<kDim, K>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+        ScatterMoments<kDim, K, false>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
       }
     });
   }
