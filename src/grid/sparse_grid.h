@@ -69,6 +69,14 @@ struct SparseGrid {
   std::vector<uint32_t> chunk_cursor;
   using WallPartial = std::array<Real, 45>;  // 6 faces x 7 sums + 3 (grid_update.cpp)
   std::vector<WallPartial> wall_partials;    // per-block wall reactions (grid_update.cpp)
+  struct GhostNode {      // a node with mass beyond a domain wall (MirrorGhostNodes)
+    uint32_t node;        // its index
+    int32_t wall;         // index into the active walls (ActiveWalls)
+    Vec3i mirror;         // node coordinate of its mirror image inside the domain
+  };
+  std::vector<GhostNode> ghosts;
+  std::vector<Vec3i> ghost_mirror_block;   // [2 g]: block of the mirror node, [2 g + 1]: of the
+  std::vector<int32_t> ghost_mirror_index; //   node on the wall plane below the ghost (if any)
 
   std::unique_ptr<BlockTopology> topology;
 

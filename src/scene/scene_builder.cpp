@@ -329,6 +329,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   model.domain_max = spec.domain.max;
   model.walls = spec.domain.walls;
   model.exit_policy = spec.domain.on_exit;
+  model.mirror_ghost_nodes = spec.domain.mirror_ghost_nodes;
   for (const MaterialSpec& m : spec.materials) {
     model.materials.push_back(
         Material{m.name, m.density, FindMaterialKind(m.model).make_params(m)});

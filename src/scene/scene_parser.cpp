@@ -53,6 +53,7 @@ constexpr EnumName<UpdateScheme> kUpdateNames[] = {{"usl", UpdateScheme::kUsl},
                                                    {"musl", UpdateScheme::kMusl}};
 constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
+constexpr EnumName<bool> kGhostNames[] = {{"mirror", true}, {"constrain", false}};
 constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockingMethod::kNone},
                                                              {"node", AntiLockingMethod::kNode},
                                                              {"cell", AntiLockingMethod::kCell},
@@ -1250,7 +1251,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
 
   {
     const YAML::Node d = Need(root, "", "domain");
-    ExpectMap(d, "domain", {"min", "max", "walls", "on_exit"});
+    ExpectMap(d, "domain", {"min", "max", "walls", "on_exit", "ghost_nodes"});
     spec.domain.min = Vector(Need(d, "domain", "min"), "domain.min", "m");
     spec.domain.max = Vector(Need(d, "domain", "max"), "domain.max", "m");
     for (int a = 0; a < dim_; ++a) {
@@ -1274,6 +1275,9 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
       }
     }
     if (d["on_exit"]) spec.domain.on_exit = Enum(d["on_exit"], "domain.on_exit", kExitNames);
+    if (d["ghost_nodes"]) {
+      spec.domain.mirror_ghost_nodes = Enum(d["ghost_nodes"], "domain.ghost_nodes", kGhostNames);
+    }
   }
 
   {
@@ -1674,6 +1678,7 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   }
   e << YAML::EndMap;
   e << YAML::Key << "on_exit" << YAML::Value << NameOf(kExitNames, spec.domain.on_exit);
+  e << YAML::Key << "ghost_nodes" << YAML::Value << NameOf(kGhostNames, spec.domain.mirror_ghost_nodes);
   e << YAML::EndMap;
 
   e << YAML::Key << "materials" << YAML::Value << YAML::BeginMap;

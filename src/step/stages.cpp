@@ -39,6 +39,13 @@ void GridUpdateStage(const Model& m, const StepContext& c, State& s, Workspace& 
   s.wall_work += r.walls.work;
 }
 
+// After the obstacles, so that a ghost node mirrors the final velocity inside the domain.
+void WallGhostStage(const Model& m, const StepContext& c, State& s, Workspace& w, StepReport& r) {
+  const Real work = r.walls.work;
+  MirrorGhostNodes(m, c, w.grid, true, &r.walls);
+  s.wall_work += r.walls.work - work;
+}
+
 void ObstacleContactStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                           StepReport& r) {
   ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, &r.obstacles);

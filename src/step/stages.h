@@ -13,6 +13,7 @@ void ReorderParticlesStage(const Model&, const StepContext&, State&, Workspace&,
 void ParticleToGridStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridUpdateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Node contact with the rigid obstacles on v_{n+1} (src/contact), reactions into the report.
+void WallGhostStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void ObstacleContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void BodyContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Local damping of the free components of v_{n+1} while ctx.damping > 0 (src/transfer).

@@ -91,6 +91,103 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
   }
 }
 
+void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& grid, bool collect,
+                      WallReport* report) {
+  WallPlane walls[kFaceCount];
+  const int wall_count = ActiveWalls(model, walls);
+  const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, as in UpdateGridVelocity
+  if (collect) {
+    grid.ghosts.clear();
+    for (size_t b = 0; b < grid.block_count(); ++b) {
+      const Vec3i origin = grid.block_origin[b];
+      for (int k = 0; k < wall_count; ++k) {
+        const WallPlane& w = walls[k];
+        const int a = w.axis;
+        const int outer = w.sign > 0 ? origin[a] : origin[a] + kBlockDim - 1;  // farthest out
+        if (w.sign * (outer * ctx.dx - w.level) >= -tolerance) continue;       // none beyond
+        // Mirror image of node index n across the plane: 2 level / dx - n (exact for a wall on
+        // a node or half-way between two; else the nearest node, docs/walls.md).
+        const int twice = int(std::lround(2 * w.level * ctx.inv_dx));
+        for (int l = 0; l < kBlockNodes; ++l) {
+          const size_t i = b * kBlockNodes + l;
+          if (!(grid.mass[i] > 0)) continue;
+          const Vec3i n = origin + Vec3i(l / 64, (l / 8) % 8, l % 8);
+          if (w.sign * (n[a] * ctx.dx - w.level) >= -tolerance) continue;  // on or inside
+          Vec3i mirror = n;
+          mirror[a] = twice - n[a];
+          grid.ghosts.push_back({uint32_t(i), k, mirror});
+        }
+      }
+    }
+    const size_t n = grid.ghosts.size();
+    grid.ghost_mirror_block.resize(2 * n);
+    grid.ghost_mirror_index.resize(2 * n);
+    // arithmetic shift = floor division (C++20), as in RebuildGrid
+    auto block_of = [](const Vec3i& c) {
+      return Vec3i(c.x() >> kBlockBits, c.y() >> kBlockBits, c.z() >> kBlockBits);
+    };
+    for (size_t g = 0; g < n; ++g) {
+      const SparseGrid::GhostNode& gh = grid.ghosts[g];
+      const int a = walls[gh.wall].axis;
+      Vec3i plane = gh.mirror;  // the node on the wall plane between ghost and mirror
+      plane[a] = int(std::lround(walls[gh.wall].level * ctx.inv_dx));
+      grid.ghost_mirror_block[2 * g] = block_of(gh.mirror);
+      grid.ghost_mirror_block[2 * g + 1] = block_of(plane);
+    }
+    LookupBlocks(grid, grid.ghost_mirror_block.data(), 2 * n, grid.ghost_mirror_index.data());
+  }
+  auto node_index = [&](size_t k, const Vec3i& c) -> int64_t {  // -1: not active or no mass
+    const int32_t b = grid.ghost_mirror_index[k];
+    if (b < 0) return -1;
+    const Vec3i local = c - grid.ghost_mirror_block[k] * kBlockDim;
+    const size_t j = size_t(b) * kBlockNodes + LocalNode(local.x(), local.y(), local.z());
+    return grid.mass[j] > 0 ? int64_t(j) : -1;
+  };
+  const bool keep_reaction = report && !model.sensors.empty();
+  // Serial, in block order: a ghost reads only nodes inside the domain along its wall's axis and
+  // writes only its own component along that axis, so the result does not depend on the order.
+  for (size_t g = 0; g < grid.ghosts.size(); ++g) {
+    const SparseGrid::GhostNode& gh = grid.ghosts[g];
+    const WallPlane& w = walls[gh.wall];
+    const int a = w.axis;
+    const int64_t j = node_index(2 * g, gh.mirror);
+    const Real u = j >= 0 ? grid.velocity_new[size_t(j)][a] : 0;  // the mirror's v_{n+1} along a
+    if (w.wall.separable && w.wall.kind != WallKind::kNoSlip) {
+      // Separable wall: mirror only where the material presses on the wall, i.e. where the
+      // wall removed an inflow at the node on the plane below (its free prediction moves out
+      // of the domain); elsewhere the material may leave and the ghost keeps v.n >= 0. With no
+      // node on the plane (a wall half-way between nodes) the mirror's own motion decides.
+      Vec3i plane = gh.mirror;
+      plane[a] = int(std::lround(w.level * ctx.inv_dx));
+      const bool on_plane = std::abs(plane[a] * ctx.dx - w.level) <= tolerance;
+      bool pressing = w.sign * u < 0;
+      if (on_plane) {
+        const int64_t k = node_index(2 * g + 1, plane);
+        pressing = k >= 0 && w.sign * (grid.velocity[size_t(k)][a] +
+                                       ctx.dt * (grid.force[size_t(k)][a] / grid.mass[size_t(k)] +
+                                                 ctx.gravity[a])) < 0;
+      }
+      if (!pressing) continue;
+    }
+    Vec3& v = grid.velocity_new[gh.node];
+    const Vec3 before = v;
+    v[a] = -u;  // odd extension of the normal velocity across the plane
+    if (!report) continue;
+    const size_t i = gh.node;
+    const Real m = grid.mass[i];
+    const Vec3 vu = grid.velocity[i] + ctx.dt * (grid.force[i] / m + ctx.gravity);
+    const Vec3 r = -m * (v - before) / ctx.dt;  // the wall's extra reaction (spec §5.3)
+    const size_t b = i / kBlockNodes;
+    const int l = int(i % kBlockNodes);
+    const Vec3 x = (grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8)).cast<Real>() * ctx.dx;
+    report->force[w.face] += r;
+    report->torque[w.face] += x.cross(r);
+    report->work += m * ((v - vu).dot(v) - (before - vu).dot(before));
+    report->max_nodal_force = std::max(report->max_nodal_force, m * (v - vu).norm() / ctx.dt);
+    if (keep_reaction) grid.reaction[i] = m * (vu - v) / ctx.dt;
+  }
+}
+
 // Cundall's local damping (Anura3D manual §6.3.1): m a = f + f_damp (6.22), f_damp = -alpha |f|
 // v/|v| per degree of freedom (6.23), f = f_ext - f_int the unbalanced nodal force (gravity and
 // tractions included), v = v_n the nodal velocity at the start of the step (a component at rest
@@ -138,6 +235,7 @@ void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGri
       grid.velocity_new[i] = v;
     }
   });
+  if (model.mirror_ghost_nodes && wall_count > 0) MirrorGhostNodes(model, ctx, grid, false, nullptr);
 }
 
 }  // namespace surge

@@ -45,6 +45,17 @@ struct WallReport {
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report);
 
+// Mirrored ghost nodes at domain walls (docs/walls.md): a node with mass beyond a wall (outside
+// the domain, not on the wall plane) takes minus the normal velocity v_{n+1} of its mirror image
+// across the wall plane, so that the interpolated normal velocity sum_i N_i v_i vanishes on the
+// plane for every symmetric kernel (quadratic and cubic B-splines reach past the wall; linear
+// does not). On a separable wall a ghost whose mirror moves away from the wall keeps its own
+// constraint. With `report`, the momentum this moves is added to the walls' reactions. Lists
+// the ghost nodes (grid.ghosts) when `collect`, else reuses this step's list (MUSL re-map).
+// Pre: v_{n+1} constrained by ApplyWalls at every node (UpdateGridVelocity).
+void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& grid, bool collect,
+                      WallReport* report);
+
 // Local damping (Anura3D manual §6.3.1, (6.22)-(6.23); docs/antilocking.md) with the factor
 // ctx.damping on the components of v_{n+1} that no wall or obstacle constrained. Reads mass,
 // force, velocity (v_n); writes velocity_new. Pre: UpdateGridVelocity and the obstacle contact

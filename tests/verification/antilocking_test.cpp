@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "support/obstacle_checks.h"
 #include "support/run_scene.h"
 
 namespace surge {
@@ -130,13 +131,14 @@ struct PressureSamples {
 // (seed App. B.2.3) and the state observed after settling. Returns the RMS over particles (their
 // pressure time-averaged over the last 0.25 s) of p - rho g depth, relative to the base pressure
 // rho g h; h = m / (rho0 W) is the incompressible surface height.
-Real TankPressureRms(const std::string& method) {
+Real TankPressureRms(const std::string& method, const std::string& ghosts = "constrain") {
   constexpr Real kW = 0.114, kRho = 997.5, kG = 9.81, kEnd = 1.0, kAvgFrom = 0.75;
   LoadedScene scene = LoadScene(
       testing::ScenePath("dam_break_2d.yaml"),
       {"domain.max=[0.114, 0.228]", "grid.cell_size=0.0095", "bodies.0.particles_per_cell=2",
        "bodies.0.region.box.max=[0.114, 0.057]", "gravity_ramp=0.2",
-       "materials.water.antilocking={method: " + method + "}"});  // method [, stress: true]
+       "materials.water.antilocking={method: " + method + "}",  // method [, stress: true]
+       "domain.ghost_nodes=" + ghosts});
   Real mass = 0;
   for (Real m : scene.state.particles.mass) mass += m;
   const Real h = mass / (kRho * kW);
@@ -152,9 +154,9 @@ Real TankPressureRms(const std::string& method) {
   Real noise = 0;
   for (Real f : floor) noise += (f - mass * kG) * (f - mass * kG);
   noise = std::sqrt(noise / Real(floor.size())) / (mass * kG);
-  std::printf("tank at rest, antilocking %-5s: RMS(p - rho g depth) / rho g h = %.4f (%zu "
-              "particles); floor force RMS(R - m g) / m g = %.2e\n",
-              method.c_str(), rms, samples.pressure.size(), noise);
+  std::printf("tank at rest, antilocking %-5s, ghost nodes %s: RMS(p - rho g depth) / rho g h = "
+              "%.4f (%zu particles); floor force RMS(R - m g) / m g = %.2e\n",
+              method.c_str(), ghosts.c_str(), rms, samples.pressure.size(), noise);
   EXPECT_LT(noise, 0.02) << "the floor must carry the weight";
   return rms;
 }
@@ -202,6 +204,17 @@ TEST(AntilockingTest, CellStressAveragingMakesTheMeanStressCellConstant) {
 // In the tank at rest, the stress approximation on top of the strain one: cell-based it changes
 // nothing (the strain projection already makes a fluid's pressure cell-constant), node-based it
 // smooths the pressure a second time (docs/antilocking.md).
+// Mirrored ghost nodes (domain.ghost_nodes: mirror, docs/walls.md) in the same tank: with the
+// interpolated normal velocity zero on the walls the pressure RMS falls from 4.2 % to 3.3 %
+// (node-based AS1, measured 2026-12-01).
+TEST(AntilockingTest, MirroredGhostNodesLowerTheTankPressureError) {
+  const Real constrained = TankPressureRms("node");
+  const Real mirrored = TankPressureRms("node", "mirror");
+  std::printf("tank, node-based: ghost nodes constrain %.4f, mirror %.4f\n", constrained, mirrored);
+  EXPECT_LT(mirrored, 0.9 * constrained);
+  EXPECT_LT(mirrored, 0.04);
+}
+
 TEST(AntilockingTest, StressAveragingInATank) {
   const Real node = TankPressureRms("node, stress: true");
   const Real cell = TankPressureRms("cell, stress: true");
@@ -304,6 +317,35 @@ TEST(AntilockingTest, StrainSmoothingUnlocksTheCantileverAndSmoothsTheTankPressu
   EXPECT_NEAR(beam.period_ratio, 1.0, 0.03);
   EXPECT_NEAR(beam.amplitude_ratio, 1.0, 0.03);
   EXPECT_LT(TankPressureRms("smoothing, strain: total"), 0.10);
+}
+
+
+// By hand (about 2 min): the dam break with barrier damped for 6 s after the impact (to 8 s),
+// with constrained and with mirrored ghost nodes: the pressure RMS and the crowding of the bottom
+// 0.15 m band (sum of the particles' initial volumes over the band's volume). Measured
+// 2026-12-01: constrain RMS 0.102, crowding 1.43; mirror RMS 0.069, crowding 1.35 (docs/walls.md):
+// the mirror helps, but most of the crowding has another cause.
+TEST(AntilockingTest, DISABLED_BarrierSettledWithMirroredGhostNodes) {
+  for (const char* ghosts : {"mirror", "constrain"}) {
+    constexpr Real kRho = 997.5, kG = 9.81, kFloor = 6.0, kBand = 0.15;
+    LoadedScene scene = LoadScene(testing::ScenePath("dam_break_barrier_2d.yaml"),
+                                  {std::string("domain.ghost_nodes=") + ghosts});
+    const Real h = testing::TotalMass(scene.state.particles) / (kRho * kFloor);
+    testing::RunUntil(scene, 2.0, [](const State&, const StepReport&) {});
+    scene.model.damping = LocalDamping{0.7, 8.0};
+    PressureSamples samples;
+    testing::RunUntil(scene, 8.25, [&](const State& s, const StepReport&) {
+      if (s.time >= 8.0) samples.Add(s.particles);
+    });
+    Real volume = 0;
+    const Particles& P = scene.state.particles;
+    for (size_t p = 0; p < P.size(); ++p)
+      if (P.x[p].y() < kBand && P.x[p].x() < kFloor) volume += P.volume0[p];
+    const Real rms = samples.RmsAboutHydrostatic(kRho, kG, h);
+    std::printf("barrier damped to 8 s, ghost nodes %s: RMS %.4f, bottom band crowding %.3f\n",
+                ghosts, rms, volume / (kBand * kFloor));
+    EXPECT_LT(rms, 0.2);
+  }
 }
 
 }  // namespace
