@@ -139,9 +139,9 @@ struct Model {
   std::array<Wall, kFaceCount> walls;
   // Ghost nodes (nodes beyond a wall) take the mirror image of the normal velocity inside, so
   // the interpolated normal velocity vanishes on the wall plane (MirrorGhostNodes, scene key
-  // domain.ghost_nodes: mirror); false (the default, `constrain`): each ghost node is constrained
+  // domain.ghost_nodes: mirror, the default); false (`constrain`): each ghost node is constrained
   // like a node on the wall (the normal inflow removed).
-  bool mirror_ghost_nodes = false;
+  bool mirror_ghost_nodes = true;
   ExitPolicy exit_policy = ExitPolicy::kRemove;
   std::vector<Material> materials;
   std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none

@@ -50,7 +50,7 @@ struct DomainSpec {
   Vec3 max = Vec3::Zero();            // required [m], > min in each seeded component
   std::array<Wall, kFaceCount> walls; // missing faces are open
   ExitPolicy on_exit = ExitPolicy::kRemove;
-  bool mirror_ghost_nodes = false;    // ghost_nodes: mirror | constrain (default)
+  bool mirror_ghost_nodes = true;     // ghost_nodes: mirror (default) | constrain
 };
 
 // Material models known to the scene file; names and constructors live in the one table in

@@ -131,14 +131,15 @@ struct PressureSamples {
 // (seed App. B.2.3) and the state observed after settling. Returns the RMS over particles (their
 // pressure time-averaged over the last 0.25 s) of p - rho g depth, relative to the base pressure
 // rho g h; h = m / (rho0 W) is the incompressible surface height.
-Real TankPressureRms(const std::string& method, const std::string& ghosts = "constrain") {
+// `ghosts`: domain.ghost_nodes, empty for the default (mirror).
+Real TankPressureRms(const std::string& method, const std::string& ghosts = "") {
   constexpr Real kW = 0.114, kRho = 997.5, kG = 9.81, kEnd = 1.0, kAvgFrom = 0.75;
-  LoadedScene scene = LoadScene(
-      testing::ScenePath("dam_break_2d.yaml"),
-      {"domain.max=[0.114, 0.228]", "grid.cell_size=0.0095", "bodies.0.particles_per_cell=2",
-       "bodies.0.region.box.max=[0.114, 0.057]", "gravity_ramp=0.2",
-       "materials.water.antilocking={method: " + method + "}",  // method [, stress: true]
-       "domain.ghost_nodes=" + ghosts});
+  std::vector<std::string> overrides = {
+      "domain.max=[0.114, 0.228]", "grid.cell_size=0.0095", "bodies.0.particles_per_cell=2",
+      "bodies.0.region.box.max=[0.114, 0.057]", "gravity_ramp=0.2",
+      "materials.water.antilocking={method: " + method + "}"};  // method [, stress: true]
+  if (!ghosts.empty()) overrides.push_back("domain.ghost_nodes=" + ghosts);
+  LoadedScene scene = LoadScene(testing::ScenePath("dam_break_2d.yaml"), overrides);
   Real mass = 0;
   for (Real m : scene.state.particles.mass) mass += m;
   const Real h = mass / (kRho * kW);
@@ -156,7 +157,7 @@ Real TankPressureRms(const std::string& method, const std::string& ghosts = "con
   noise = std::sqrt(noise / Real(floor.size())) / (mass * kG);
   std::printf("tank at rest, antilocking %-5s, ghost nodes %s: RMS(p - rho g depth) / rho g h = "
               "%.4f (%zu particles); floor force RMS(R - m g) / m g = %.2e\n",
-              method.c_str(), ghosts.c_str(), rms, samples.pressure.size(), noise);
+              method.c_str(), ghosts.empty() ? "default" : ghosts.c_str(), rms, samples.pressure.size(), noise);
   EXPECT_LT(noise, 0.02) << "the floor must carry the weight";
   return rms;
 }
@@ -206,9 +207,9 @@ TEST(AntilockingTest, CellStressAveragingMakesTheMeanStressCellConstant) {
 // smooths the pressure a second time (docs/antilocking.md).
 // Mirrored ghost nodes (domain.ghost_nodes: mirror, docs/walls.md) in the same tank: with the
 // interpolated normal velocity zero on the walls the pressure RMS falls from 4.2 % to 3.3 %
-// (node-based AS1, measured 2026-12-01).
+// (node-based AS1, measured 2026-12-01). The other tank tests run with the default, mirror.
 TEST(AntilockingTest, MirroredGhostNodesLowerTheTankPressureError) {
-  const Real constrained = TankPressureRms("node");
+  const Real constrained = TankPressureRms("node", "constrain");
   const Real mirrored = TankPressureRms("node", "mirror");
   std::printf("tank, node-based: ghost nodes constrain %.4f, mirror %.4f\n", constrained, mirrored);
   EXPECT_LT(mirrored, 0.9 * constrained);
@@ -258,10 +259,14 @@ TEST(AntilockingTest, FullTensorApproachesOnTheIncompressibleCantilever) {
 // the deviator of a fluid at rest carries no pressure): below 5 %.
 TEST(AntilockingTest, HybridGivesHydrostaticPressureInATank) {
   EXPECT_LT(TankPressureRms("hybrid"), 0.05);
-  // Node-based AS3CV: the trace is node-based AS1's (4.2 %); node-based AS2 fits the trace
-  // linearly over each node's support (6.2 %).
+  // Node-based AS3CV: the trace is node-based AS1's (3.3 %); node-based AS2 fits the trace
+  // linearly over each node's support (6.2 % with constrained ghost nodes). With mirrored ghost
+  // nodes (the default) AS2's column rings on after the gravity ramp (floor force RMS 18 % of the
+  // weight over 0.75-1 s, 3 % over 0.9-1 s; constrained 0.7 % and 0.03 %): the wall layer
+  // dissipates less, and AS2's ringing decays more slowly than AS1's (docs/walls.md). Its
+  // settled pressure is therefore measured with constrained ghosts.
   EXPECT_LT(TankPressureRms("node, approach: constant_volumetric"), 0.05);
-  EXPECT_LT(TankPressureRms("node, approach: volumetric_deviatoric"), 0.10);
+  EXPECT_LT(TankPressureRms("node, approach: volumetric_deviatoric", "constrain"), 0.10);
 }
 
 // The seed's dam break with barrier (§6.1.2, scenes/dam_break_barrier_2d.yaml: a 4 x 2 m column

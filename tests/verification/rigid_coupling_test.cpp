@@ -190,7 +190,7 @@ TEST(RigidCouplingTest, LightBoxFloatsInForceBalanceWithTheKnownLidForceDeficit)
   const Floating f = FloatingBox(Tank{});
   EXPECT_NEAR(f.force, f.weight, 0.03 * f.weight);  // at rest the water carries the box
   EXPECT_GT(f.draft, f.expected);                    // deeper than Archimedes (the known gap)
-  EXPECT_LT(f.draft, 1.08 * f.expected);             // measured +4.9 %
+  EXPECT_LT(f.draft, 1.08 * f.expected);             // measured +4.9 %; +6.8 % with mirrored ghost nodes (2026-12-01)
   EXPECT_GT(f.draft_tank, f.draft);                  // the crowding under the box
 }
 
