@@ -1251,7 +1251,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
 
   {
     const YAML::Node d = Need(root, "", "domain");
-    ExpectMap(d, "domain", {"min", "max", "walls", "on_exit", "ghost_nodes"});
+    ExpectMap(d, "domain", {"min", "max", "walls", "on_exit", "ghost_nodes", "gap_test"});
     spec.domain.min = Vector(Need(d, "domain", "min"), "domain.min", "m");
     spec.domain.max = Vector(Need(d, "domain", "max"), "domain.max", "m");
     for (int a = 0; a < dim_; ++a) {
@@ -1275,6 +1275,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
       }
     }
     if (d["on_exit"]) spec.domain.on_exit = Enum(d["on_exit"], "domain.on_exit", kExitNames);
+    if (d["gap_test"]) spec.domain.gap_test = Bool(d["gap_test"], "domain.gap_test");
     if (d["ghost_nodes"]) {
       spec.domain.mirror_ghost_nodes = Enum(d["ghost_nodes"], "domain.ghost_nodes", kGhostNames);
     }
@@ -1679,6 +1680,7 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   e << YAML::EndMap;
   e << YAML::Key << "on_exit" << YAML::Value << NameOf(kExitNames, spec.domain.on_exit);
   e << YAML::Key << "ghost_nodes" << YAML::Value << NameOf(kGhostNames, spec.domain.mirror_ghost_nodes);
+  e << YAML::Key << "gap_test" << YAML::Value << spec.domain.gap_test;
   e << YAML::EndMap;
 
   e << YAML::Key << "materials" << YAML::Value << YAML::BeginMap;

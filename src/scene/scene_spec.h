@@ -51,6 +51,7 @@ struct DomainSpec {
   std::array<Wall, kFaceCount> walls; // missing faces are open
   ExitPolicy on_exit = ExitPolicy::kRemove;
   bool mirror_ghost_nodes = true;     // ghost_nodes: mirror (default) | constrain
+  bool gap_test = true;               // gap_test: true (default) | false
 };
 
 // Material models known to the scene file; names and constructors live in the one table in

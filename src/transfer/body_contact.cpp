@@ -168,7 +168,7 @@ void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& gr
         if (wall_count > 0) {
           const Vec3 before = v;
           Vec3 dvw[kFaceCount];
-          if (ApplyWalls(walls, wall_count, x, tolerance, v, dvw)) {
+          if (ApplyWalls(walls, wall_count, x, tolerance, v, dvw, &grid, node)) {
             for (int k = 0; k < wall_count; ++k) {
               const Vec3 r = -mf * dvw[k] / ctx.dt;  // reaction on the wall (spec §5.3)
               const Vec3 tq = x.cross(r);

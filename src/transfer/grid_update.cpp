@@ -19,6 +19,70 @@ constexpr int kFaceSums = 7;
 constexpr int kWork = kFaceSums * kFaceCount, kMaxNodal = kWork + 1, kMaxElevation = kWork + 2;
 static_assert(kMaxElevation + 1 == std::tuple_size_v<SparseGrid::WallPartial>);
 
+void MarkWallContacts(const Model& model, const StepContext& ctx, const Particles& P,
+                      SparseGrid& grid) {
+  WallPlane walls[kFaceCount];
+  const int wall_count = ActiveWalls(model, walls);
+  for (auto& t : grid.wall_touch) t.touched.clear();
+  if (!model.wall_gap_test || wall_count == 0) return;
+  // Reach of a particle's kernel along the wall [m]: where its stencil has non-zero weights.
+  const Real reach = ctx.dx * (model.shape == ShapeFunction::kLinear                ? 1.0
+                               : model.shape == ShapeFunction::kQuadraticBspline ? 1.5
+                               : model.shape == ShapeFunction::kCubicBspline     ? 2.0
+                                                                                 : 1.0);
+  for (int k = 0; k < wall_count; ++k) {
+    SparseGrid::WallTouch& t = grid.wall_touch[k];
+    t.axis = walls[k].axis;
+    for (int j = 1; j <= 2; ++j) {
+      const int a = (t.axis + j) % 3;
+      const bool used = a < model.dim;
+      // node columns over the domain plus 3 cells either side (stencils reach past it)
+      const int lo = used ? int(std::floor(model.domain_min[a] * ctx.inv_dx)) - 3 : 0;
+      const int hi = used ? int(std::ceil(model.domain_max[a] * ctx.inv_dx)) + 3 : 0;
+      t.lo[a] = lo;
+      (j == 1 ? t.n1 : t.n2) = hi - lo + 1;
+    }
+    t.touched.assign(size_t(t.n1) * size_t(t.n2), 0);
+  }
+  // Find the touching particles in parallel (per chunk, in particle order), mark serially: the
+  // marks are a set, so the result is the same for any thread count.
+  const size_t n = P.size();
+  ParallelChunks(n, [&](size_t chunk, size_t b, size_t e) {
+    std::vector<uint32_t>& out = grid.touch_scratch[chunk];
+    out.clear();
+    for (size_t p = b; p < e; ++p) {
+      const Real half = 0.5 * (model.dim == 3 ? std::cbrt(P.volume0[p]) : std::sqrt(P.volume0[p]));
+      for (int k = 0; k < wall_count; ++k) {
+        const Real d = walls[k].sign * (P.x[p][walls[k].axis] - walls[k].level);
+        if (d <= 1.5 * half) out.push_back(uint32_t(p) * 8 + uint32_t(k));
+      }
+    }
+  });
+  for (size_t c = 0; c < grid.touch_scratch.size(); ++c)
+    for (const uint32_t entry : grid.touch_scratch[c]) {
+      const size_t p = entry / 8;
+      const int k = int(entry % 8);
+      SparseGrid::WallTouch& t = grid.wall_touch[k];
+      const Real half = 0.5 * (model.dim == 3 ? std::cbrt(P.volume0[p]) : std::sqrt(P.volume0[p]));
+      const Real r = model.shape == ShapeFunction::kGimp ? reach + half : reach;
+      int range[2][2];  // node index range along the two tangential axes
+      for (int j = 1; j <= 2; ++j) {
+        const int a = (t.axis + j) % 3;
+        if (a >= model.dim) {
+          range[j - 1][0] = range[j - 1][1] = 0;
+          continue;
+        }
+        // nodes with |x_i - x_p| < r (a weight exactly at the edge of the support is zero)
+        range[j - 1][0] = int(std::floor((P.x[p][a] - r) * ctx.inv_dx)) + 1;
+        range[j - 1][1] = int(std::ceil((P.x[p][a] + r) * ctx.inv_dx)) - 1;
+      }
+      const int a1 = (t.axis + 1) % 3, a2 = (t.axis + 2) % 3;
+      for (int i1 = std::max(range[0][0] - t.lo[a1], 0); i1 <= std::min(range[0][1] - t.lo[a1], t.n1 - 1); ++i1)
+        for (int i2 = std::max(range[1][0] - t.lo[a2], 0); i2 <= std::min(range[1][1] - t.lo[a2], t.n2 - 1); ++i2)
+          t.touched[size_t(i1) * t.n2 + i2] = 1;
+    }
+}
+
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report) {
   WallPlane walls[kFaceCount];
@@ -51,11 +115,11 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
         const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
         const Vec3 x = node.cast<Real>() * ctx.dx;
         Vec3 dv[kFaceCount];
-        if (ApplyWalls(walls, wall_count, x, tolerance, vc, dv)) {
+        if (ApplyWalls(walls, wall_count, x, tolerance, vc, dv, &grid, node)) {
           // Reaction on each wall: R = -m dv / dt (spec §5.3), its moment, its node count.
           for (int k = 0; k < wall_count; ++k) {
             const Real depth = walls[k].sign * (x[walls[k].axis] - walls[k].level);
-            if (depth > tolerance) continue;  // this wall did not act on the node
+            if (depth > tolerance || !WallTouched(grid, k, node)) continue;  // did not act here
             Real* f = &part[kFaceSums * walls[k].face];
             const Vec3 r = -m * dv[k] / ctx.dt;
             const Vec3 tq = x.cross(r);
@@ -150,6 +214,11 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     const SparseGrid::GhostNode& gh = grid.ghosts[g];
     const WallPlane& w = walls[gh.wall];
     const int a = w.axis;
+    {  // a ghost in a column the material does not touch stays free
+      const size_t b = gh.node / kBlockNodes;
+      const int l = int(gh.node % kBlockNodes);
+      if (!WallTouched(grid, gh.wall, grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8))) continue;
+    }
     const int64_t j = node_index(2 * g, gh.mirror);
     const Real u = j >= 0 ? grid.velocity_new[size_t(j)][a] : 0;  // the mirror's v_{n+1} along a
     if (w.wall.separable && w.wall.kind != WallKind::kNoSlip) {
@@ -230,7 +299,7 @@ void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGri
       if (wall_count > 0) {
         const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
         Vec3 dv[kFaceCount];
-        ApplyWalls(walls, wall_count, node.cast<Real>() * ctx.dx, tolerance, v, dv);
+        ApplyWalls(walls, wall_count, node.cast<Real>() * ctx.dx, tolerance, v, dv, &grid, node);
       }
       grid.velocity_new[i] = v;
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/model.h"
+#include "grid/sparse_grid.h"
 
 namespace surge {
 
@@ -29,17 +30,28 @@ inline int ActiveWalls(const Model& model, WallPlane* out) {
   return count;
 }
 
-// Constrains node velocity v (node at position xn) by every wall the node lies on or beyond,
-// in face order. Slip: v.n >= 0 (separable) or v.n = 0; no-slip: v = 0 (seed Fixed); friction:
+// Whether the material touches active wall k in the node column of `node` (MarkWallContacts);
+// true when the gap test is off.
+inline bool WallTouched(const SparseGrid& grid, int k, const Vec3i& node) {
+  const SparseGrid::WallTouch& t = grid.wall_touch[k];
+  if (t.touched.empty()) return true;
+  const int i1 = node[(t.axis + 1) % 3] - t.lo[(t.axis + 1) % 3];
+  const int i2 = node[(t.axis + 2) % 3] - t.lo[(t.axis + 2) % 3];
+  return i1 >= 0 && i1 < t.n1 && i2 >= 0 && i2 < t.n2 && t.touched[size_t(i1) * t.n2 + i2];
+}
+
+// Constrains node velocity v (node `node`, at position xn) by every wall the node lies on or
+// beyond and the material touches there (WallTouched on `grid`; null: every wall), in face order. Slip: v.n >= 0 (separable) or v.n = 0; no-slip: v = 0 (seed Fixed); friction:
 // Coulomb limit |dv_t| <= mu |dv_n| on the tangential velocity (Bardenhagen et al. 2000,
 // eq. (11)). dv[k] receives the velocity change made by wall k. Returns true when any wall acted.
 inline bool ApplyWalls(const WallPlane* walls, int count, const Vec3& xn, Real tolerance, Vec3& v,
-                       Vec3* dv) {
+                       Vec3* dv, const SparseGrid* grid = nullptr, const Vec3i& node = Vec3i::Zero()) {
   bool acted = false;
   for (int k = 0; k < count; ++k) {
     const WallPlane& w = walls[k];
     dv[k].setZero();
     if (w.sign * (xn[w.axis] - w.level) > tolerance) continue;  // node inside the domain
+    if (grid && !WallTouched(*grid, k, node)) continue;  // the material has not reached it here
     acted = true;
     const Vec3 before = v;
     if (w.wall.kind == WallKind::kNoSlip) {
