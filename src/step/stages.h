@@ -12,8 +12,9 @@ void RebuildGridStage(const Model&, const StepContext&, State&, Workspace&, Step
 void ReorderParticlesStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void ParticleToGridStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridUpdateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
-// Node contact with the rigid obstacles on v_{n+1} (src/contact), reactions into the report.
+// Mirrored ghost nodes at the domain walls (MirrorGhostNodes), after the obstacle contact.
 void WallGhostStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// Node contact with the rigid obstacles on v_{n+1} (src/contact), reactions into the report.
 void ObstacleContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void BodyContactStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // Local damping of the free components of v_{n+1} while ctx.damping > 0 (src/transfer).

@@ -160,6 +160,10 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
   WallPlane walls[kFaceCount];
   const int wall_count = ActiveWalls(model, walls);
   const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, as in UpdateGridVelocity
+  auto node_coord = [&](size_t i) {  // node index of grid node i
+    const int l = int(i % kBlockNodes);
+    return Vec3i(grid.block_origin[i / kBlockNodes] + Vec3i(l / 64, (l / 8) % 8, l % 8));
+  };
   if (collect) {
     grid.ghosts.clear();
     for (size_t b = 0; b < grid.block_count(); ++b) {
@@ -175,7 +179,7 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
         for (int l = 0; l < kBlockNodes; ++l) {
           const size_t i = b * kBlockNodes + l;
           if (!(grid.mass[i] > 0)) continue;
-          const Vec3i n = origin + Vec3i(l / 64, (l / 8) % 8, l % 8);
+          const Vec3i n = node_coord(i);
           if (w.sign * (n[a] * ctx.dx - w.level) >= -tolerance) continue;  // on or inside
           Vec3i mirror = n;
           mirror[a] = twice - n[a];
@@ -214,11 +218,8 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     const SparseGrid::GhostNode& gh = grid.ghosts[g];
     const WallPlane& w = walls[gh.wall];
     const int a = w.axis;
-    {  // a ghost in a column the material does not touch stays free
-      const size_t b = gh.node / kBlockNodes;
-      const int l = int(gh.node % kBlockNodes);
-      if (!WallTouched(grid, gh.wall, grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8))) continue;
-    }
+    const Vec3i ghost = node_coord(gh.node);
+    if (!WallTouched(grid, gh.wall, ghost)) continue;  // not touched here: the ghost stays free
     const int64_t j = node_index(2 * g, gh.mirror);
     const Real u = j >= 0 ? grid.velocity_new[size_t(j)][a] : 0;  // the mirror's v_{n+1} along a
     if (w.wall.separable && w.wall.kind != WallKind::kNoSlip) {
@@ -246,9 +247,7 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     const Real m = grid.mass[i];
     const Vec3 vu = grid.velocity[i] + ctx.dt * (grid.force[i] / m + ctx.gravity);
     const Vec3 r = -m * (v - before) / ctx.dt;  // the wall's extra reaction (spec §5.3)
-    const size_t b = i / kBlockNodes;
-    const int l = int(i % kBlockNodes);
-    const Vec3 x = (grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8)).cast<Real>() * ctx.dx;
+    const Vec3 x = ghost.cast<Real>() * ctx.dx;
     report->force[w.face] += r;
     report->torque[w.face] += x.cross(r);
     report->work += m * ((v - vu).dot(v) - (before - vu).dot(before));
