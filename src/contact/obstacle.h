@@ -83,6 +83,16 @@ struct ObstacleContact {
   bool separable = true;  // false: sticky (bilateral in the normal direction)
   Real adhesion = 0;      // separable only: tensile strength of the contact [Pa]; a node is
                           // released once pulling it back would need more than adhesion x h^(d-1)
+  // faces: interpolated (true, the default): a planar face of a box or plane constrains the
+  // velocity the kernel interpolates at the face, on each node column through it, so that the
+  // face's position within a cell reaches the solution (contact.cpp, docs/obstacle-faces.md);
+  // nodes (false): every node on or inside the obstacle is constrained on its own.
+  bool interpolated_faces = true;
+  // gap_test (true, the default): the contact acts only at nodes in the stencil of a particle
+  // that touches the obstacle (signed distance <= 1.5 x its half-size), so that material a cell
+  // or two away is not stopped short of the surface (docs/obstacle-faces.md); false: at every
+  // node with mass the contact reaches.
+  bool gap_test = true;
 };
 
 struct Obstacle {

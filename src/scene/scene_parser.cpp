@@ -54,6 +54,7 @@ constexpr EnumName<UpdateScheme> kUpdateNames[] = {{"usl", UpdateScheme::kUsl},
 constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
 constexpr EnumName<bool> kGhostNames[] = {{"mirror", true}, {"constrain", false}};
+constexpr EnumName<bool> kFaceConstraintNames[] = {{"interpolated", true}, {"nodes", false}};
 constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockingMethod::kNone},
                                                              {"node", AntiLockingMethod::kNode},
                                                              {"cell", AntiLockingMethod::kCell},
@@ -1055,7 +1056,16 @@ ObstacleSpec Parser::ParseObstacle(const YAML::Node& n, const std::string& path)
   if (n["contact"]) {
     const YAML::Node c = n["contact"];
     const std::string cp = Child(path, "contact");
-    ExpectMap(c, cp, {"friction", "separable", "adhesion"});
+    ExpectMap(c, cp, {"friction", "separable", "adhesion", "faces", "gap_test"});
+    if (c["faces"]) {
+      o.contact.interpolated_faces = Enum(c["faces"], Child(cp, "faces"), kFaceConstraintNames);
+    }
+    if (c["gap_test"]) o.contact.gap_test = Bool(c["gap_test"], Child(cp, "gap_test"));
+    if (o.contact.interpolated_faces && !o.contact.gap_test) {
+      Fail(c["gap_test"], Child(cp, "gap_test"),
+           "faces: interpolated needs the gap test (without it a face column stops material up to "
+           "two cells before the face); set faces: nodes to run without it");
+    }
     if (c["friction"]) o.contact.friction = NonNegative(c["friction"], Child(cp, "friction"), "-");
     if (c["separable"]) o.contact.separable = Bool(c["separable"], Child(cp, "separable"));
     if (c["adhesion"]) {
@@ -1616,7 +1626,9 @@ void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
   e << YAML::Key << "contact" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
     << "friction" << YAML::Value << Num(o.contact.friction) << YAML::Key << "separable"
     << YAML::Value << o.contact.separable << YAML::Key << "adhesion" << YAML::Value
-    << Num(o.contact.adhesion) << YAML::EndMap;
+    << Num(o.contact.adhesion) << YAML::Key << "faces" << YAML::Value
+    << NameOf(kFaceConstraintNames, o.contact.interpolated_faces) << YAML::Key << "gap_test"
+    << YAML::Value << o.contact.gap_test << YAML::EndMap;
   if (o.reference_point) {
     e << YAML::Key << "reference_point" << YAML::Value;
     EmitVector(e, *o.reference_point, dim);

@@ -49,7 +49,7 @@ void WallGhostStage(const Model& m, const StepContext& c, State& s, Workspace& w
 
 void ObstacleContactStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                           StepReport& r) {
-  ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, &r.obstacles);
+  ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, &r.obstacles, &s.particles);
 }
 
 void BodyContactStage(const Model& m, const StepContext& c, State&, Workspace& w,
@@ -85,7 +85,8 @@ void RemapMomentumStage(const Model& m, const StepContext& c, State& s, Workspac
   RemapMomentum(m, c, s.particles, w.grid);
   // The re-mapped velocities obey the obstacles too (no reaction logged: the step's impulse
   // was counted in ObstacleContact).
-  if (!m.obstacles.empty()) ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, nullptr);
+  if (!m.obstacles.empty())
+    ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, nullptr, &s.particles);
 }
 
 void VelocityGradientStage(const Model& m, const StepContext& c, State& s, Workspace& w,

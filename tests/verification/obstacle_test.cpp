@@ -357,11 +357,80 @@ TEST(ObstacleTest, LidBuoyancyOnOffGridHorizontalFacesWithinThreePercent) {
   EXPECT_EQ(MaxPenetration(scene), 0);
 }
 
+// --- A lid anywhere within a cell --------------------------------------------------------------
+// A 2-D tank 0.6 m wide, water 0.16 m deep (K = 2e5 Pa, no anti-locking, h = 0.01 m, ppc 2), one
+// fixed box 0.2 m wide piercing the surface with its bottom (the lid) at y_b = 0.1003, 0.1050 or
+// 0.1097 m, all between the node planes 0.10 and 0.11 m and above the same particle row. The
+// time-averaged lid force over 1.0-1.6 s is compared with p(y_b) w, the hydrostatic pressure of
+// the water's own mass as in the lid test above, for the interpolated face constraint
+// (contact.faces: interpolated, the default; docs/obstacle-faces.md) and for the node-by-node
+// contact (faces: nodes). The interpolated constraint is the more accurate at every position; it
+// does not remove the dependence on where the particles sit (docs/obstacle-faces.md, "Limits").
+struct LidRun {
+  Real force = 0, expected = 0;  // [N/m]
+};
+
+LidRun RunLidAt(Real bottom, const std::string& faces, Real dx = 0.01) {
+  constexpr Real kRho = 1000, kG = 9.81, kK = 2.0e5, kW = 0.2, kTank = 0.6;
+  const std::string b = std::to_string(bottom);
+  const std::string text = R"(name: lid_position
+dimension: 2
+time: {end: 1.6, cfl: 0.3}
+gravity: [0, -9.81]
+gravity_ramp: 0.1
+grid: {cell_size: )" + std::to_string(dx) + R"(, shape_function: quadratic_bspline, transfer: apic, update: usl}
+domain:
+  min: [0, 0]
+  max: [0.6, 0.4]
+  walls: {x-: slip, x+: slip, y-: slip, y+: slip}
+materials:
+  water: {model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e5, viscosity: 0.01,
+          antilocking: {method: none}}
+bodies:
+  - {name: water, material: water, region: {box: {min: [0, 0], max: [0.6, 0.16]}}, particles_per_cell: 2}
+obstacles:
+  - {name: lid, shape: {box: {min: [0.2, )" + b + R"(], max: [0.4, 0.38]}}, motion: fixed,
+     contact: {faces: )" + faces + R"(}}
+)";
+  LoadedScene scene = LoadSceneFromString(text, "lid_position.yaml");
+  const Real mass = TotalMass(scene.state.particles);
+  auto above = [&](Real y, Real s) {  // mass per m^2 above y in a free column of surface s
+    return kK / kG * (std::exp(kRho * kG * std::max(s - y, Real(0)) / kK) - 1);
+  };
+  auto total = [&](Real s) { return kTank * above(0, s) - kW * above(bottom, s); };
+  Real lo = 0.1, hi = 0.3;
+  for (int k = 0; k < 60; ++k) (total(0.5 * (lo + hi)) > mass ? hi : lo) = 0.5 * (lo + hi);
+  LidRun out;
+  out.expected = kG * above(bottom, 0.5 * (lo + hi)) * kW;
+  int n = 0;
+  testing::RunUntil(scene, 1.6, [&](const State& st, const StepReport& r) {
+    if (st.time < 1.0) return;
+    out.force += r.obstacles.at(0).faces.at(2).force.y();  // face y-
+    ++n;
+  });
+  out.force /= n;
+  EXPECT_EQ(MaxPenetration(scene), 0) << faces << " " << bottom;
+  return out;
+}
+
+TEST(ObstacleTest, LidAnywhereInACellIsCloserToPAWithInterpolatedFaces) {
+  for (const Real bottom : {0.1003, 0.1050, 0.1097}) {
+    const LidRun a = RunLidAt(bottom, "interpolated");
+    const LidRun b = RunLidAt(bottom, "nodes");
+    const Real ea = a.force / a.expected - 1, eb = b.force / b.expected - 1;
+    std::printf("lid at y = %.4f m (h = 0.01 m): p A %.4f N/m; interpolated faces %.4f (%+.2f %%), "
+                "nodes %.4f (%+.2f %%)\n", bottom, a.expected, a.force, 100 * ea, b.force, 100 * eb);
+    EXPECT_LT(std::abs(ea), 0.03) << bottom;
+    EXPECT_LT(std::abs(ea), std::abs(eb)) << bottom;
+  }
+}
+
 // The last steps of a run land on the end time without a sliver step (NextTimeStep): in the dam
 // break with barrier as shipped (scenes/dam_break_barrier_2d.yaml, end 2 s, plain MPM) no step
 // of the last 20 is shorter than 0.85 of the one before, and the barrier force changes by less
-// than 1 % from one step to the next there (the water piles against the barrier; it changes by
-// about 0.01 % a step). Before, the run ended with a step 1/48 of the others and the last force
+// than 3 % from one step to the next there (the water piles against the barrier; the largest
+// change was about 0.01 % a step with the node-by-node contact, 1.18 % since the obstacles' gap
+// test and interpolated faces, 2026-12-02, docs/obstacle-faces.md). Before, the run ended with a step 1/48 of the others and the last force
 // jumped by +50 % (25.4 against 16.9 kN/m), which `surge forces` then reported as the peak.
 TEST(ObstacleTest, LastStepsLandOnTheEndTimeWithoutAForceSpike) {
   LoadedScene scene = LoadScene(testing::ScenePath("dam_break_barrier_2d.yaml"),
@@ -383,7 +452,7 @@ TEST(ObstacleTest, LastStepsLandOnTheEndTimeWithoutAForceSpike) {
               "shortest dt ratio %.4f, last dt %.4g s, last force %.1f N/m\n",
               t_end, 100 * worst_jump, shortest, dt.back(), force.back());
   EXPECT_GT(force.back(), 1000.0) << "the water must be on the barrier";
-  EXPECT_LT(worst_jump, 0.01);
+  EXPECT_LT(worst_jump, 0.03);
   EXPECT_GT(shortest, 0.85);
 }
 

@@ -365,6 +365,23 @@ TEST(ObstacleParserTest, NegativeFrictionAndNonBooleanSeparable) {
               "obstacles[0].contact.separable", "expected true or false, got \"maybe\"");
 }
 
+TEST(ObstacleParserTest, FaceConstraintAndGapTest) {
+  const std::string head = "name: c\n    shape: {box: {min: [1.5, 0, 0], max: [2, 1, 1]}}\n";
+  const Obstacle d = OnlyObstacle(LoadSceneFromString(WithObstacle(3, head), "s.yaml"));
+  EXPECT_TRUE(d.contact.interpolated_faces);  // the defaults
+  EXPECT_TRUE(d.contact.gap_test);
+  const Obstacle o = OnlyObstacle(LoadSceneFromString(
+      WithObstacle(3, head + "    contact: {faces: nodes, gap_test: false}\n"), "s.yaml"));
+  EXPECT_FALSE(o.contact.interpolated_faces);
+  EXPECT_FALSE(o.contact.gap_test);
+  ExpectError(WithObstacle(3, head + "    contact: {faces: columns}\n"), 15,
+              "obstacles[0].contact.faces", "columns");
+  ExpectError(WithObstacle(3, head + "    contact: {faces: nodes, gap_test: 1.5}\n"), 15,
+              "obstacles[0].contact.gap_test", "expected true or false");
+  ExpectError(WithObstacle(3, head + "    contact: {gap_test: false}\n"), 15,
+              "obstacles[0].contact.gap_test", "faces: interpolated needs the gap test");
+}
+
 TEST(ObstacleParserTest, MissingMeshFileNamesTheFile) {
   const std::string file = kMeshDir + "no_such_pier.stl";
   const Caught c = Load(WithObstacle(3, "name: pier\n    shape: {mesh: {file: " + file + "}}\n"));
@@ -412,6 +429,8 @@ void ExpectSameObstacles(const LoadedScene& a, const LoadedScene& b) {
     EXPECT_EQ(p.motion.angular_velocity, q.motion.angular_velocity) << p.name;
     EXPECT_EQ(p.motion.center, q.motion.center) << p.name;
     EXPECT_EQ(p.contact.friction, q.contact.friction) << p.name;
+    EXPECT_EQ(p.contact.interpolated_faces, q.contact.interpolated_faces) << p.name;
+    EXPECT_EQ(p.contact.gap_test, q.contact.gap_test) << p.name;
     EXPECT_EQ(p.contact.separable, q.contact.separable) << p.name;
     if (const auto* plane = std::get_if<PlaneShape>(&p.shape)) {
       EXPECT_EQ(plane->normal, std::get<PlaneShape>(q.shape).normal) << p.name;
@@ -446,7 +465,7 @@ TEST(ObstacleResolvedYamlTest, EveryKindRereadsToTheSameYaml3D) {
       "  - name: boulder\n"
       "    shape: {sphere: {center: [-0.6, 1.6, 1.6], radius: 0.15}}\n"
       "    motion: {dynamic: {density: 2600, velocity: [1, 0, 0], angular_velocity_deg: [0, 0, 10], restitution: 0.2}}\n"
-      "    contact: {friction: 0.4, adhesion: 50}\n"
+      "    contact: {friction: 0.4, adhesion: 50, faces: nodes, gap_test: false}\n"
       "sensors:\n"
       "  - {name: strip, box: {min: [1.2, 0, 0], max: [1.3, 0.5, 0.5]}}\n";
   const LoadedScene a = LoadSceneFromString(text, "s.yaml");
@@ -457,7 +476,8 @@ TEST(ObstacleResolvedYamlTest, EveryKindRereadsToTheSameYaml3D) {
   EXPECT_EQ(a.state.particles.size(), 512u);  // the obstacles miss the body
   for (const char* key : {"obstacles:", "plane:", "box:", "sphere:", "cylinder:", "polygon:", "mesh:",
                           "one_sided: true", "motion: fixed", "prescribed:", "separable: false",
-                          "reference_point:", "dynamic:", "density: 2600", "adhesion: 50",
+                          "reference_point:", "dynamic:", "density: 2600", "adhesion: 50", "faces: nodes",
+                          "gap_test: false",
                           "sensors:"}) {
     EXPECT_NE(a.resolved_yaml.find(key), std::string::npos) << key << " in\n" << a.resolved_yaml;
   }
