@@ -425,6 +425,45 @@ TEST(ObstacleTest, LidAnywhereInACellIsCloserToPAWithInterpolatedFaces) {
   }
 }
 
+// --- The contact acts when the material arrives -------------------------------------------------
+// The seed's column impact as shipped (scenes/column_impact_3d.yaml, h = 0.5 m, 2 particles per
+// cell: half-size r = 0.125 m; dt <= 2e-3 s as in the CI sweep) up to t = 0.7 s: the surge front
+// (largest particle x) at the first step the column's impact face x- (at x = 9 m) carries more than
+// 1 kN. With the obstacles' gap test (contact.gap_test, the default; docs/obstacle-faces.md) the
+// front is then within the touch distance 1.5 r of the face (allowing one step of travel, < 0.05
+// m); with the old node-by-node contact the column felt the surge while the front was still about
+// 1.5 h = 0.75 m away. Measured 2026-12-02: default, first force at t = 0.498 s with the front at
+// 8.813 m (0.187 m short of the face); old contact, t = 0.268 s, front 8.277 m (0.72 m short).
+struct FirstContact {
+  Real time = -1, front = 0;  // [s], [m]
+};
+
+FirstContact FirstColumnForce(const std::vector<std::string>& overrides) {
+  std::vector<std::string> o = {"time.max_dt=2e-3", "time.end=0.7"};
+  o.insert(o.end(), overrides.begin(), overrides.end());
+  LoadedScene scene = LoadScene(testing::ScenePath("column_impact_3d.yaml"), o);
+  FirstContact first;
+  testing::RunUntil(scene, 0.7, [&](const State& s, const StepReport& r) {
+    if (first.time >= 0 || std::abs(r.obstacles.at(0).faces.at(0).force.x()) <= 1e3) return;
+    first.time = s.time;
+    for (const Vec3& x : s.particles.x) first.front = std::max(first.front, x.x());
+  });
+  return first;
+}
+
+TEST(ObstacleTest, ColumnFeelsTheSurgeOnlyWhenItArrives) {
+  constexpr Real kFace = 9.0, kTouch = 1.5 * 0.125;
+  const FirstContact now = FirstColumnForce({});
+  const FirstContact old =
+      FirstColumnForce({"obstacles.0.contact.faces=nodes", "obstacles.0.contact.gap_test=false"});
+  std::printf("column impact, first force > 1 kN on face x-: default t = %.3f s, front %.4f m; "
+              "old contact t = %.3f s, front %.4f m (face at %.1f m)\n",
+              now.time, now.front, old.time, old.front, kFace);
+  ASSERT_GT(now.time, 0) << "the surge must reach the column by 0.7 s";
+  EXPECT_GT(now.front, kFace - kTouch - 0.05);
+  EXPECT_LT(old.front, kFace - 0.5);  // the defect: the old contact acts a cell and more early
+}
+
 // The last steps of a run land on the end time without a sliver step (NextTimeStep): in the dam
 // break with barrier as shipped (scenes/dam_break_barrier_2d.yaml, end 2 s, plain MPM) no step
 // of the last 20 is shorter than 0.85 of the one before, and the barrier force changes by less
