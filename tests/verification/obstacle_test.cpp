@@ -6,6 +6,7 @@
 // particle may end inside an obstacle.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -281,6 +282,25 @@ TEST(ObstacleTest, AdhesionHoldsAHangingBlockOnlyWhenStrongEnough) {
   EXPECT_LT(strong, 0.002);  // elastic sag only
 }
 
+// Hydrostatics of the 2-D water tanks below (rho0 = 1000 kg/m^3, K = 2e5 Pa, g = 9.81): the mass
+// per m^2 above height y in a free column whose surface is s, with rho = rho0 exp(p / K) (first
+// order in p / K < 1 %: K/g (exp(rho0 g (s - y) / K) - 1)), and the surface s at which a tank
+// `tank` wide holds `mass` [kg/m] around fixed boxes {width, bottom, top} (bisection).
+constexpr Real kTankRho = 1000, kTankG = 9.81, kTankK = 2.0e5;
+Real MassAbove(Real y, Real s) {
+  return kTankK / kTankG * (std::exp(kTankRho * kTankG * std::max(s - y, Real(0)) / kTankK) - 1);
+}
+Real SurfaceFromMass(Real mass, Real tank, const std::vector<std::array<Real, 3>>& boxes) {
+  auto total = [&](Real s) {
+    Real m = tank * MassAbove(0, s);
+    for (const auto& b : boxes) m -= b[0] * (MassAbove(b[1], s) - MassAbove(b[2], s));
+    return m;
+  };
+  Real lo = 0.1, hi = 0.3;
+  for (int k = 0; k < 60; ++k) (total(0.5 * (lo + hi)) > mass ? hi : lo) = 0.5 * (lo + hi);
+  return 0.5 * (lo + hi);
+}
+
 // --- Lid buoyancy (force on downward- and upward-facing faces) ------------------------------------
 // A 2-D tank 0.6 m wide, water ~0.2 m deep (K = 2e5 Pa, no anti-locking, h = 0.01 m, ppc 2), two
 // fixed boxes 0.16 m wide with their horizontal faces half a cell off the grid planes: A pierces the
@@ -317,22 +337,13 @@ obstacles:
 )";
 
 TEST(ObstacleTest, LidBuoyancyOnOffGridHorizontalFacesWithinThreePercent) {
-  constexpr Real kRho = 1000, kG = 9.81, kK = 2.0e5, kW = 0.16, kTank = 0.6;
+  constexpr Real kW = 0.16, kTank = 0.6;
   constexpr Real kA = 0.105, kB0 = 0.045, kB1 = 0.125;  // lid A, lid B, top of B
   constexpr int kYMin = 2, kYMax = 3;                   // box faces x-, x+, y-, y+
   LoadedScene scene = LoadSceneFromString(kLidScene, "lid_buoyancy.yaml");
-  const Real mass = TotalMass(scene.state.particles);
-  // Mass per m^2 above y in a free column whose surface is s, and the surface from the mass.
-  auto above = [&](Real y, Real s) {
-    return kK / kG * (std::exp(kRho * kG * std::max(s - y, Real(0)) / kK) - 1);
-  };
-  auto total = [&](Real s) {
-    return kTank * above(0, s) - kW * above(kA, s) - kW * (above(kB0, s) - above(kB1, s));
-  };
-  Real lo = 0.1, hi = 0.3;
-  for (int k = 0; k < 60; ++k) (total(0.5 * (lo + hi)) > mass ? hi : lo) = 0.5 * (lo + hi);
-  const Real s = 0.5 * (lo + hi);
-  auto load = [&](Real y) { return kG * above(y, s) * kW; };  // p(y) x width [N/m]
+  const Real s = SurfaceFromMass(TotalMass(scene.state.particles), kTank,
+                                 {{kW, kA, 1e9}, {kW, kB0, kB1}});  // A pierces the surface
+  auto load = [&](Real y) { return kTankG * MassAbove(y, s) * kW; };  // p(y) x width [N/m]
   Real lid_a = 0, lid_b = 0, top_b = 0;
   int n = 0;
   testing::RunUntil(scene, 1.6, [&](const State& st, const StepReport& r) {
@@ -371,7 +382,7 @@ struct LidRun {
 };
 
 LidRun RunLidAt(Real bottom, const std::string& faces, Real dx = 0.01) {
-  constexpr Real kRho = 1000, kG = 9.81, kK = 2.0e5, kW = 0.2, kTank = 0.6;
+  constexpr Real kW = 0.2, kTank = 0.6;
   const std::string b = std::to_string(bottom);
   const std::string text = R"(name: lid_position
 dimension: 2
@@ -393,15 +404,9 @@ obstacles:
      contact: {faces: )" + faces + R"(}}
 )";
   LoadedScene scene = LoadSceneFromString(text, "lid_position.yaml");
-  const Real mass = TotalMass(scene.state.particles);
-  auto above = [&](Real y, Real s) {  // mass per m^2 above y in a free column of surface s
-    return kK / kG * (std::exp(kRho * kG * std::max(s - y, Real(0)) / kK) - 1);
-  };
-  auto total = [&](Real s) { return kTank * above(0, s) - kW * above(bottom, s); };
-  Real lo = 0.1, hi = 0.3;
-  for (int k = 0; k < 60; ++k) (total(0.5 * (lo + hi)) > mass ? hi : lo) = 0.5 * (lo + hi);
+  const Real s = SurfaceFromMass(TotalMass(scene.state.particles), kTank, {{kW, bottom, 1e9}});
   LidRun out;
-  out.expected = kG * above(bottom, 0.5 * (lo + hi)) * kW;
+  out.expected = kTankG * MassAbove(bottom, s) * kW;
   int n = 0;
   testing::RunUntil(scene, 1.6, [&](const State& st, const StepReport& r) {
     if (st.time < 1.0) return;
