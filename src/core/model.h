@@ -21,6 +21,16 @@ enum class Face { kXMin = 0, kXMax, kYMin, kYMax, kZMin, kZMax };
 inline constexpr int kFaceCount = 6;
 const char* FaceName(Face f);  // "x-", "x+", ...
 
+// Nodes beyond a domain wall ("ghost nodes", reached by the quadratic and cubic B-splines;
+// MirrorGhostNodes, docs/walls.md), scene key domain.ghost_nodes.
+enum class GhostNodes {
+  kConstrain,       // `constrain`: each ghost is constrained like the node on the wall
+  kMirrorVelocity,  // `mirror_velocity`: the ghost's normal v_{n+1} is set to minus its mirror's
+  kMirror,          // `mirror` (default): the ghost's momentum and mass are folded into its mirror
+                    // node (the odd extension in the Galerkin sense), then the ghost takes minus
+                    // the mirror's velocity; no-slip walls fold every component
+};
+
 enum class WallKind {
   kOpen,     // no wall: particles leaving are removed or stop the run (Model::exit_policy)
   kSlip,     // v.n >= 0 (separable) or v.n = 0 (bilateral); tangential free (seed Planar)
@@ -139,9 +149,9 @@ struct Model {
   std::array<Wall, kFaceCount> walls;
   // Ghost nodes (nodes beyond a wall) take the mirror image of the normal velocity inside, so
   // the interpolated normal velocity vanishes on the wall plane (MirrorGhostNodes, scene key
-  // domain.ghost_nodes: mirror, the default); false (`constrain`): each ghost node is constrained
-  // like a node on the wall (the normal inflow removed).
-  bool mirror_ghost_nodes = true;
+  // domain.ghost_nodes: mirror, the default, or mirror_velocity); `constrain`: each ghost node is
+  // constrained like a node on the wall (the normal inflow removed).
+  GhostNodes ghost_nodes = GhostNodes::kMirror;
   // Gap test at domain walls (MarkWallContacts; scene key domain.gap_test): a wall acts at a node
   // only where a particle touches the wall in that node's column (its centre within 1.5 of its
   // half-size of the plane); false: wherever a node on or beyond the wall has mass.

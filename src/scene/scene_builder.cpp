@@ -329,7 +329,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   model.domain_max = spec.domain.max;
   model.walls = spec.domain.walls;
   model.exit_policy = spec.domain.on_exit;
-  model.mirror_ghost_nodes = spec.domain.mirror_ghost_nodes;
+  model.ghost_nodes = spec.domain.ghost_nodes;
   model.wall_gap_test = spec.domain.gap_test;
   for (const MaterialSpec& m : spec.materials) {
     model.materials.push_back(

@@ -53,7 +53,9 @@ constexpr EnumName<UpdateScheme> kUpdateNames[] = {{"usl", UpdateScheme::kUsl},
                                                    {"musl", UpdateScheme::kMusl}};
 constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
-constexpr EnumName<bool> kGhostNames[] = {{"mirror", true}, {"constrain", false}};
+constexpr EnumName<GhostNodes> kGhostNames[] = {{"mirror", GhostNodes::kMirror},
+                                                {"mirror_velocity", GhostNodes::kMirrorVelocity},
+                                                {"constrain", GhostNodes::kConstrain}};
 constexpr EnumName<bool> kFaceConstraintNames[] = {{"interpolated", true}, {"nodes", false}};
 constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockingMethod::kNone},
                                                              {"node", AntiLockingMethod::kNode},
@@ -1287,7 +1289,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
     if (d["on_exit"]) spec.domain.on_exit = Enum(d["on_exit"], "domain.on_exit", kExitNames);
     if (d["gap_test"]) spec.domain.gap_test = Bool(d["gap_test"], "domain.gap_test");
     if (d["ghost_nodes"]) {
-      spec.domain.mirror_ghost_nodes = Enum(d["ghost_nodes"], "domain.ghost_nodes", kGhostNames);
+      spec.domain.ghost_nodes = Enum(d["ghost_nodes"], "domain.ghost_nodes", kGhostNames);
     }
   }
 
@@ -1691,7 +1693,7 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
   }
   e << YAML::EndMap;
   e << YAML::Key << "on_exit" << YAML::Value << NameOf(kExitNames, spec.domain.on_exit);
-  e << YAML::Key << "ghost_nodes" << YAML::Value << NameOf(kGhostNames, spec.domain.mirror_ghost_nodes);
+  e << YAML::Key << "ghost_nodes" << YAML::Value << NameOf(kGhostNames, spec.domain.ghost_nodes);
   e << YAML::Key << "gap_test" << YAML::Value << spec.domain.gap_test;
   e << YAML::EndMap;
 

@@ -50,7 +50,7 @@ struct DomainSpec {
   Vec3 max = Vec3::Zero();            // required [m], > min in each seeded component
   std::array<Wall, kFaceCount> walls; // missing faces are open
   ExitPolicy on_exit = ExitPolicy::kRemove;
-  bool mirror_ghost_nodes = true;     // ghost_nodes: mirror (default) | constrain
+  GhostNodes ghost_nodes = GhostNodes::kMirror;  // mirror (default) | mirror_velocity | constrain
   bool gap_test = true;               // gap_test: true (default) | false
 };
 

@@ -41,7 +41,7 @@ Pipeline MakePipeline(const Model& model) {
   if (obstacles) p.push_back({Stage::kObstacleContact, ObstacleContactStage});  // spec §5.3
   const bool walls = std::any_of(model.walls.begin(), model.walls.begin() + 2 * model.dim,
                                  [](const Wall& w) { return w.kind != WallKind::kOpen; });
-  if (model.mirror_ghost_nodes && walls)  // docs/walls.md; timed with the grid update
+  if (model.ghost_nodes != GhostNodes::kConstrain && walls)  // docs/walls.md; timed with the grid update
     p.push_back({Stage::kGridUpdate, WallGhostStage});
   if (model.field_count > 0) p.push_back({Stage::kBodyContact, BodyContactStage});  // Anura3D §6.2
   if (model.damping.alpha > 0) p.push_back({Stage::kLocalDamping, LocalDampingStage});  // A3D (6.23)

@@ -212,8 +212,23 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     return grid.mass[j] > 0 ? int64_t(j) : -1;
   };
   const bool keep_reaction = report && !model.sensors.empty();
-  // Serial, in block order: a ghost reads only nodes inside the domain along its wall's axis and
-  // writes only its own component along that axis, so the result does not depend on the order.
+  const bool fold = model.ghost_nodes == GhostNodes::kMirror;
+  // The walls' extra reaction, work and sensor share for a velocity change at node i from
+  // `before` to its current v_{n+1} (spec §5.3: the momentum the constraint removes).
+  auto credit = [&](const WallPlane& w, size_t i, const Vec3i& c, const Vec3& before) {
+    const Vec3& v = grid.velocity_new[i];
+    const Real m = grid.mass[i];
+    const Vec3 vu = grid.velocity[i] + ctx.dt * (grid.force[i] / m + ctx.gravity);
+    const Vec3 r = -m * (v - before) / ctx.dt;
+    const Vec3 x = c.cast<Real>() * ctx.dx;
+    report->force[w.face] += r;
+    report->torque[w.face] += x.cross(r);
+    report->work += m * ((v - vu).dot(v) - (before - vu).dot(before));
+    report->max_nodal_force = std::max(report->max_nodal_force, m * (v - vu).norm() / ctx.dt);
+    if (keep_reaction) grid.reaction[i] += r;
+  };
+  // Serial, in block order: a ghost reads its mirror inside the domain along its wall's axis and
+  // writes only the ghost and that mirror, so the result does not depend on the thread count.
   for (size_t g = 0; g < grid.ghosts.size(); ++g) {
     const SparseGrid::GhostNode& gh = grid.ghosts[g];
     const WallPlane& w = walls[gh.wall];
@@ -239,20 +254,47 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
       }
       if (!pressing) continue;
     }
-    Vec3& v = grid.velocity_new[gh.node];
-    const Vec3 before = v;
-    v[a] = -u;  // odd extension of the normal velocity across the plane
-    if (!report) continue;
     const size_t i = gh.node;
-    const Real m = grid.mass[i];
-    const Vec3 vu = grid.velocity[i] + ctx.dt * (grid.force[i] / m + ctx.gravity);
-    const Vec3 r = -m * (v - before) / ctx.dt;  // the wall's extra reaction (spec §5.3)
-    const Vec3 x = ghost.cast<Real>() * ctx.dx;
-    report->force[w.face] += r;
-    report->torque[w.face] += x.cross(r);
-    report->work += m * ((v - vu).dot(v) - (before - vu).dot(before));
-    report->max_nodal_force = std::max(report->max_nodal_force, m * (v - vu).norm() / ctx.dt);
-    if (keep_reaction) grid.reaction[i] = m * (vu - v) / ctx.dt;
+    Vec3& v = grid.velocity_new[i];
+    const Vec3 before = v;
+    // A mirror node on or beyond another wall keeps that wall's constraint: no fold there.
+    // Only bilateral walls fold (no-slip, and slip with `separable: false`, e.g. a symmetry
+    // plane): on a separable or frictional wall the fold would move part of the normal reaction
+    // off the wall's nodes, where the contact switch and the Coulomb limit act (measured: a block
+    // on a mu = 0.3 floor slid 11 % fast), so there the normal velocity is mirrored only.
+    const bool bilateral = w.wall.kind == WallKind::kNoSlip ||
+                           (w.wall.kind == WallKind::kSlip && !w.wall.separable);
+    bool mirror_free = fold && bilateral && j >= 0;
+    for (int kk = 0; mirror_free && kk < wall_count; ++kk)
+      mirror_free = kk == gh.wall ||
+                    walls[kk].sign * (gh.mirror[walls[kk].axis] * ctx.dx - walls[kk].level) > tolerance;
+    if (!mirror_free) {
+      v[a] = -u;  // odd extension of the normal velocity across the plane
+      if (report) credit(w, i, ghost, before);
+      continue;
+    }
+    // Folded mirror (`mirror`): with the ghost slaved to its mirror node k, v_g = S v_k (S = -1
+    // on the normal component; on every component for a no-slip wall), the Galerkin basis of
+    // node k is N_k + S N_g, so its lumped mass is m_k + m_g and its momentum m_k v_k + S m_g v_g
+    // (the reflection method for a Dirichlet condition on a symmetric B-spline basis; without it
+    // the ghost's share of the internal force is lost and a clamped elastic bar converges at
+    // first order, docs/walls.md). v_g is the ghost's own unconstrained velocity: its free
+    // prediction (2.13)-(2.14) in the grid update, its re-mapped velocity in the MUSL re-map.
+    const size_t k = size_t(j);
+    const Real mg = grid.mass[i], mk = grid.mass[k];
+    const Vec3 vg = collect ? Vec3(grid.velocity[i] + ctx.dt * (grid.force[i] / mg + ctx.gravity))
+                            : Vec3(ctx.mass_scale * grid.momentum[i] / mg);
+    Vec3& vk = grid.velocity_new[k];
+    const Vec3 before_k = vk;
+    const bool all = w.wall.kind == WallKind::kNoSlip;
+    for (int d = 0; d < 3; ++d) {
+      if (d != a && !all) continue;  // tangential components of slip and friction walls: own
+      vk[d] = (mk * vk[d] - mg * vg[d]) / (mk + mg);
+      v[d] = -vk[d];
+    }
+    if (!report) continue;
+    credit(w, i, ghost, before);
+    credit(w, k, gh.mirror, before_k);
   }
 }
 
@@ -303,7 +345,7 @@ void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGri
       grid.velocity_new[i] = v;
     }
   });
-  if (model.mirror_ghost_nodes && wall_count > 0) MirrorGhostNodes(model, ctx, grid, false, nullptr);
+  if (model.ghost_nodes != GhostNodes::kConstrain && wall_count > 0) MirrorGhostNodes(model, ctx, grid, false, nullptr);
 }
 
 }  // namespace surge

@@ -120,6 +120,20 @@ TEST(DeterminismTest, MirroredGhostNodesAreBitwiseIdenticalForOneAndTwoThreads) 
                                {sand[0], sand[1], sand[2], "domain.ghost_nodes=constrain"}, 0.06, 2));
 }
 
+TEST(DeterminismTest, FoldedGhostNodesAreBitwiseIdenticalForOneAndTwoThreads) {
+  // The folded mirror (ghost_nodes: mirror at a bilateral wall): the cantilever clamped by a
+  // no-slip wall (every component folded), with USL and with MUSL (folded again on the re-map).
+  for (const char* update : {"usl", "musl"}) {
+    const std::vector<std::string> beam = {"grid.cell_size=0.25", std::string("grid.update=") + update};
+    const uint64_t h1 = RunWithThreads("cantilever_2d.yaml", beam, 0.02, 1);
+    EXPECT_EQ(h1, RunWithThreads("cantilever_2d.yaml", beam, 0.02, 2)) << update;
+    // The fold changes the run (against the velocity-only mirror).
+    EXPECT_NE(h1, RunWithThreads("cantilever_2d.yaml",
+                                 {beam[0], beam[1], "domain.ghost_nodes=mirror_velocity"}, 0.02, 2))
+        << update;
+  }
+}
+
 TEST(DeterminismTest, MuslSceneIsBitwiseIdenticalForOneAndTwoThreads) {
   const uint64_t h1 = RunWithThreads("two_disks_2d.yaml", {}, 1.5, 1);
   const uint64_t h2 = RunWithThreads("two_disks_2d.yaml", {}, 1.5, 2);

@@ -134,8 +134,10 @@ bodies:
 }
 
 TEST(WallGhostTest, GhostNodesKeyIsParsedAndRefused) {
-  EXPECT_TRUE(LoadSceneFromString(BoxScene("mirror"), "ghost_drop.yaml").model.mirror_ghost_nodes);
-  EXPECT_FALSE(LoadSceneFromString(BoxScene("constrain"), "ghost_drop.yaml").model.mirror_ghost_nodes);
+  EXPECT_EQ(LoadSceneFromString(BoxScene("mirror"), "ghost_drop.yaml").model.ghost_nodes, GhostNodes::kMirror);
+  EXPECT_EQ(LoadSceneFromString(BoxScene("mirror_velocity"), "ghost_drop.yaml").model.ghost_nodes,
+            GhostNodes::kMirrorVelocity);
+  EXPECT_EQ(LoadSceneFromString(BoxScene("constrain"), "ghost_drop.yaml").model.ghost_nodes, GhostNodes::kConstrain);
   try {
     LoadSceneFromString(BoxScene("reflect"), "ghost_drop.yaml");
     FAIL() << "an unknown ghost_nodes value must be refused";
