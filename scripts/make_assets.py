@@ -9,6 +9,8 @@ v_deflector.stl   V-shaped deflector (two walls meeting at 90 degrees, apex upst
 terrain_patch.obj open height field (gentle slope with a bump), one-sided, normals up
 square_column.obj 1.5 x 1.5 m square column, 8.5 m tall from y = -0.5 (the seed's §7.5 column,
                   sunk 0.5 m into the bed), centred on x = z = 0, closed; rotate it with rotate_deg
+thin_plate.obj    plate 1 cm thick (x in [-0.005, 0.005]), 1 m wide (z in [-0.5, 0.5]), y from 0 to
+                  1 m, closed: the stability suite's thin mesh obstacle (scenes/stress/)
 
 Checks: closed meshes have every edge used exactly twice, in opposite directions (consistent
 orientation) and a positive volume (outward); no triangle has an area below 1e-6 * diagonal^2.
@@ -199,6 +201,9 @@ def main():
         ("square_column", "obj",
          prism([(-0.75, -0.75), (0.75, -0.75), (0.75, 0.75), (-0.75, 0.75)], -0.5, 8.0), True,
          "square column 1.5 m x 1.5 m, y from -0.5 to 8 m, centred on x = z = 0, closed"),
+        ("thin_plate", "obj",
+         prism([(-0.005, -0.5), (0.005, -0.5), (0.005, 0.5), (-0.005, 0.5)], 0.0, 1.0), True,
+         "thin plate 0.01 m x 1 m x 1 m (x, y, z), x in [-0.005, 0.005], z in [-0.5, 0.5], closed"),
     ]
     for name, ext, (vertices, triangles), closed, comment in meshes:
         check(name, vertices, triangles, closed)

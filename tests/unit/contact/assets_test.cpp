@@ -71,6 +71,18 @@ TEST(AssetsTest, SquareColumnIsClosedAndSquare) {
   EXPECT_NEAR(field.Query(Vec3(1.75, 4, 1.75), kInf).distance, std::sqrt(2.0), 1e-6);  // corner
 }
 
+TEST(AssetsTest, ThinPlateIsClosedAndOneCentimetreThick) {
+  const TriangleMesh mesh = Asset("thin_plate.obj");
+  EXPECT_EQ(CountOpenEdges(mesh), 0);
+  ExpectBounds(mesh, Vec3(-0.005, 0, -0.5), Vec3(0.005, 1, 0.5));
+  const MeshDistanceField field(mesh, false);
+  EXPECT_NEAR(field.Query(Vec3(0, 0.5, 0), kInf).distance, -0.005, 1e-6);  // mid-plane
+  const MeshDistance front = field.Query(Vec3(-0.02, 0.5, 0.1), kInf);    // before face x-
+  EXPECT_NEAR(front.distance, 0.015, 1e-6);
+  EXPECT_GT(front.normal.dot(-Vec3::UnitX()), 0.99);
+  EXPECT_NEAR(field.Query(Vec3(0.02, 0.5, -0.1), kInf).distance, 0.015, 1e-6);  // behind it
+}
+
 TEST(AssetsTest, VDeflectorIsClosedAndItsOpeningIsOutside) {
   const TriangleMesh mesh = Asset("v_deflector.stl");
   EXPECT_EQ(CountOpenEdges(mesh), 0);
