@@ -24,6 +24,8 @@ struct State {
   std::vector<MaterialGroup> groups;
   int64_t particles_removed = 0;  // particles that left through open domain sides
   Real wall_work = 0;             // cumulative work done on the particles by walls [J]
+  Real internal_work = 0;         // cumulative stress work sum_p V sigma : d dt on the particles
+                                  // (trapezoid per step; stored + dissipated) [J]
   std::vector<RigidBodyState> rigid;  // dynamic obstacles (ObstacleMotion::body), Bullet-stepped
 };
 

@@ -16,6 +16,8 @@ struct EnergyRecord {
   Real strain = 0;         // sum psi(F) V0 (hyperelastic) or 1/2 sigma:eps V (linear elastic)
   Real gravitational = 0;  // sum -m g . x  (zero level at the origin)
   Real wall_work = 0;      // cumulative work of the domain walls on the particles
+  Real internal_work = 0;  // cumulative stress work on the particles, sum V sigma : d dt: the strain
+                           // energy stored plus the work dissipated by plasticity and viscosity
 };
 
 enum class HealthStatus {

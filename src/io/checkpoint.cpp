@@ -378,6 +378,7 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
     WriteReal(f, "dt", s.dt, tmp);
     WriteInt(f, "particles_removed", s.particles_removed, tmp);
     WriteReal(f, "wall_work", s.wall_work, tmp);
+    WriteReal(f, "internal_work", s.internal_work, tmp);
     WriteReal(f, "next_output", c.next_output, tmp);
     WriteReal(f, "next_checkpoint", c.next_checkpoint, tmp);
     {
@@ -500,6 +501,9 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
   s.dt = ReadReal(f, "dt", path);
   s.particles_removed = ReadInt(f, "particles_removed", path);
   s.wall_work = ReadReal(f, "wall_work", path);
+  // Checkpoints before 2026-12-03 have no internal work: the sum restarts from 0 (energy output
+  // only; the motion is unaffected).
+  s.internal_work = H5Aexists(f, "internal_work") > 0 ? ReadReal(f, "internal_work", path) : 0;
   c.next_output = ReadReal(f, "next_output", path);
   c.next_checkpoint = ReadReal(f, "next_checkpoint", path);
   {

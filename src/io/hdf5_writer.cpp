@@ -129,9 +129,10 @@ void WriteArray(hid_t loc, const char* name, hid_t mem_type, hid_t file_type, co
             std::string("write dataset ") + name, path);
 }
 
-constexpr int kEnergyColumns = 8;
+constexpr int kEnergyColumns = 9;
 constexpr const char* kEnergyNames[kEnergyColumns] = {
-    "time", "step", "dt", "kinetic", "strain", "gravitational", "wall_work", "total"};
+    "time", "step", "dt", "kinetic", "strain", "gravitational", "wall_work", "total",
+    "internal_work"};
 // Buffered energy rows are written (and the file flushed) at each snapshot, on Close, and
 // whenever this many have accumulated, so a run with sparse snapshots that is killed keeps
 // all but the last few hundred rows.
@@ -593,7 +594,8 @@ struct ResultsWriter::Impl {
         const EnergyRecord& e = pending[r];
         const double row[kEnergyColumns] = {e.time,      double(e.step), e.dt,
                                             e.kinetic,   e.strain,       e.gravitational,
-                                            e.wall_work, e.kinetic + e.strain + e.gravitational};
+                                            e.wall_work, e.kinetic + e.strain + e.gravitational,
+                                            e.internal_work};
         column[r] = row[c];
       }
       const hsize_t new_size = energy_rows + add;

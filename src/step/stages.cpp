@@ -114,9 +114,29 @@ void StressAveragingStage(const Model& m, const StepContext& c, State& s, Worksp
   ProjectMeanStress(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking);
 }
 
+// Stress power sum_p J_p V0_p sigma_p : sym(L_p) [W], in fixed chunks (deterministic).
+static Real StressPower(const Particles& P, const std::vector<Mat3>& L) {
+  std::array<Real, kReductionChunks> partial{};
+  ParallelChunks(P.size(), [&](size_t c, size_t b, size_t e) {
+    Real sum = 0;
+    for (size_t p = b; p < e; ++p)
+      sum += P.F[p].determinant() * P.volume0[p] * P.stress[p].cwiseProduct(Sym(L[p])).sum();
+    partial[c] = sum;
+  });
+  Real total = 0;
+  for (Real v : partial) total += v;
+  return total;
+}
+
 void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                        StepReport&) {
+  // Internal work for the energy balance (docs/stability.md, "Energy"): the trapezoid rule on
+  // the stress power over the step, W += dt/2 (P_n + P_{n+1}), P = sum V sigma : d with the
+  // rate of deformation d = sym(L) that the stress update uses (Mast 2013 (2.18)).
+  const bool energy = m.output.energy;
+  const Real before = energy ? StressPower(s.particles, w.velocity_gradient) : 0;
   UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles);
+  if (energy) s.internal_work += 0.5 * c.dt * (before + StressPower(s.particles, w.velocity_gradient));
 }
 
 void BulkViscosityRateStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -450,6 +470,7 @@ EnergyRecord ComputeEnergy(const Model& m, const State& s) {
   }
   e.strain = StrainEnergy(m, s.groups, P);
   e.wall_work = s.wall_work;
+  e.internal_work = s.internal_work;
   e.time = s.time;
   e.step = s.step;
   e.dt = s.dt;

@@ -67,6 +67,7 @@ Checkpoint FullCheckpoint(size_t n) {
   s.dt = 3.3e-5;
   s.particles_removed = 42;
   s.wall_work = -std::nextafter(1.5, 2.0);
+  s.internal_work = std::nextafter(2.25, 3.0);
   Particles& P = s.particles;
   P.Resize(n);
   for (size_t p = 0; p < n; ++p) {
@@ -144,6 +145,7 @@ TEST_F(CheckpointTest, RoundTripIsBitwise) {
     EXPECT_EQ(r.state.dt, c.state.dt);
     EXPECT_EQ(r.state.particles_removed, 42);
     EXPECT_EQ(r.state.wall_work, c.state.wall_work);
+    EXPECT_EQ(r.state.internal_work, c.state.internal_work);
     ASSERT_EQ(r.state.groups.size(), 2u);
     EXPECT_EQ(r.state.groups[1].material, 2);
     EXPECT_EQ(r.state.groups[1].begin, n / 2);

@@ -182,7 +182,7 @@ TEST_F(ResultsWriterTest, WritesLayoutValuesTimingAndXdmf) {
     s.step = 7;
     s.particles.x[4].z() = 0.25;
     w.AppendEnergy(EnergyRecord{0.25, 3, 0.1, 1.25, 2.25, 3.25, -0.25});
-    w.AppendEnergy(EnergyRecord{0.5, 7, 0.1, 1.5, 2.5, 3.5, -0.5});
+    w.AppendEnergy(EnergyRecord{0.5, 7, 0.1, 1.5, 2.5, 3.5, -0.5, 4.75});
     w.WriteSnapshot(s);
     w.AppendEnergy(EnergyRecord{0.6, 8, 0.1, 1.0, 1.0, 1.0, 0.0});  // after the last snapshot
     EXPECT_EQ(w.snapshot_count(), 2);
@@ -249,7 +249,8 @@ TEST_F(ResultsWriterTest, WritesLayoutValuesTimingAndXdmf) {
   EXPECT_EQ(ReadDoubles(f, "/energy/step"), (std::vector<double>{0, 3, 7, 8}));
   EXPECT_EQ(ReadDoubles(f, "/energy/wall_work")[2], -0.5);
   EXPECT_EQ(ReadDoubles(f, "/energy/total")[2], 1.5 + 2.5 + 3.5);
-  for (const char* column : {"dt", "kinetic", "strain", "gravitational"})
+  EXPECT_EQ(ReadDoubles(f, "/energy/internal_work")[2], 4.75);
+  for (const char* column : {"dt", "kinetic", "strain", "gravitational", "internal_work"})
     EXPECT_EQ(Dims(f, std::string("/energy/") + column), (std::vector<hsize_t>{4})) << column;
 
   // Timing.
