@@ -47,6 +47,13 @@ def main(path):
             balance1 = e["total"][n - 1] - e["wall_work"][n - 1]
             print(f"  total - wall work: {balance0:.6g} J -> {balance1:.6g} J "
                   f"(change {balance1 - balance0:.3g} J)")
+            if "internal_work" in e:  # results from 2026-12-03 on
+                # kinetic + gravitational + internal work - wall work (+ the initial strain
+                # energy): conserved for every material up to numerical dissipation.
+                b = [e["kinetic"][i] + e["gravitational"][i] + e["internal_work"][i]
+                     - e["wall_work"][i] + e["strain"][0] for i in (0, n - 1)]
+                print(f"  energy balance (internal work included): {b[0]:.6g} J -> {b[1]:.6g} J "
+                      f"(plastic and viscous work {e['internal_work'][n - 1] - e['strain'][n - 1] + e['strain'][0]:.6g} J)")
 
         if "timing" in f:
             t = f["timing"].attrs
