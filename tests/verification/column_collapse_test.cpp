@@ -123,5 +123,27 @@ TEST(ColumnCollapseTest, RunoutInsideTheSeedBoundsAndDepositsAtRest) {
   }
 }
 
+// The short column a = 0.5 (issue 3: "does not collapse"). At the scene's h = 5 mm it is only 5
+// cells tall and its front moves about 0.06 l0, because the rough floor's stagnant layer (about
+// 1.5 cells, docs/accuracy.md) is a third of the column. At h = 2.5 mm (10 cells tall, 20 across
+// l0; 2 x 2 particles per cell) it collapses into the seed's band; the failure wedge from the toe
+// leaves the column's top at the axis where it was, as it should for a = 0.5. Run to 0.35 s
+// (the scene's end time 1.5 x 3 sqrt(h0/g) = 0.227 s left the front still creeping, kinetic
+// energy 5e-3 of its peak). Measured 2026-12-03: front L_f = 0.315 (band 0.208-0.335), (7.8)
+// L_f = 0.252, H_f = 0.500, kinetic energy at the end 6.9e-6 of its peak; 24 s of CPU.
+TEST(ColumnCollapseTest, ShortColumnCollapsesIntoTheSeedBandAtTwentyCellsAcross) {
+  const Real a = 0.5;
+  const Collapse c = RunCollapse(a, {"parameters.dx=0.0025", "time.end=0.35"});
+  const Band lb = RunoutBandDp(a), hb = HeightBandDp(a);
+  std::printf("column collapse a = 0.5, h = 2.5 mm (%zu particles, %ld steps): front runout L_f = "
+              "%.3f (DP bounds %.3f-%.3f); (7.8) L_f = %.3f, H_f = %.3f (DP bounds %.3f-%.3f); "
+              "kinetic energy at end %.2e of peak\n",
+              c.particles, c.steps, c.front_runout, lb.lower(a), lb.upper(a), c.runout, c.height,
+              hb.lower(a), hb.upper(a), c.kinetic_end / c.kinetic_peak);
+  EXPECT_LT(c.kinetic_end, 1e-3 * c.kinetic_peak) << "the deposit must be at rest";
+  EXPECT_GE(c.front_runout, lb.lower(a));
+  EXPECT_LE(c.front_runout, lb.upper(a));
+}
+
 }  // namespace
 }  // namespace surge
