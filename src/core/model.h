@@ -28,7 +28,11 @@ enum class GhostNodes {
   kMirrorVelocity,  // `mirror_velocity`: the ghost's normal v_{n+1} is set to minus its mirror's
   kMirror,          // `mirror` (default): the ghost's momentum and mass are folded into its mirror
                     // node (the odd extension in the Galerkin sense), then the ghost takes minus
-                    // the mirror's velocity; no-slip walls fold every component
+                    // the mirror's velocity; no-slip walls fold every component. Bilateral walls
+                    // only; separable and friction walls get the velocity mirror
+  kFoldAll,         // `fold_all`: as kMirror, and separable frictionless walls fold too where the
+                    // material presses on them (opt-in: removes the wall drag of flow along a
+                    // wall, but worsens node anti-locking and the floating box; docs/walls.md)
 };
 
 enum class WallKind {

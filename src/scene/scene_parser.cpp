@@ -55,6 +55,7 @@ constexpr EnumName<ExitPolicy> kExitNames[] = {{"remove", ExitPolicy::kRemove},
                                                {"stop", ExitPolicy::kStop}};
 constexpr EnumName<GhostNodes> kGhostNames[] = {{"mirror", GhostNodes::kMirror},
                                                 {"mirror_velocity", GhostNodes::kMirrorVelocity},
+                                                {"fold_all", GhostNodes::kFoldAll},
                                                 {"constrain", GhostNodes::kConstrain}};
 constexpr EnumName<bool> kFaceConstraintNames[] = {{"interpolated", true}, {"nodes", false}};
 constexpr EnumName<AntiLockingMethod> kAntiLockingNames[] = {{"none", AntiLockingMethod::kNone},

@@ -212,10 +212,14 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     return grid.mass[j] > 0 ? int64_t(j) : -1;
   };
   const bool keep_reaction = report && !model.sensors.empty();
-  const bool fold = model.ghost_nodes == GhostNodes::kMirror;
+  const bool fold = model.ghost_nodes == GhostNodes::kMirror || model.ghost_nodes == GhostNodes::kFoldAll;
+  const bool fold_separable = model.ghost_nodes == GhostNodes::kFoldAll;
   // The walls' extra reaction, work and sensor share for a velocity change at node i from
-  // `before` to its current v_{n+1} (spec §5.3: the momentum the constraint removes).
-  auto credit = [&](const WallPlane& w, size_t i, const Vec3i& c, const Vec3& before) {
+  // `before` to its current v_{n+1} (spec §5.3: the momentum the constraint removes). The sensor
+  // share goes to node `sensor_node`: the ghost for the mirror's share too, so that a force
+  // sensor at the wall (a box reaching past it) holds the whole reaction of its wall columns.
+  auto credit = [&](const WallPlane& w, size_t i, const Vec3i& c, const Vec3& before,
+                    size_t sensor_node) {
     const Vec3& v = grid.velocity_new[i];
     const Real m = grid.mass[i];
     const Vec3 vu = grid.velocity[i] + ctx.dt * (grid.force[i] / m + ctx.gravity);
@@ -225,7 +229,7 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     report->torque[w.face] += x.cross(r);
     report->work += m * ((v - vu).dot(v) - (before - vu).dot(before));
     report->max_nodal_force = std::max(report->max_nodal_force, m * (v - vu).norm() / ctx.dt);
-    if (keep_reaction) grid.reaction[i] += r;
+    if (keep_reaction) grid.reaction[sensor_node] += r;
   };
   // Serial, in block order: a ghost reads its mirror inside the domain along its wall's axis and
   // writes only the ghost and that mirror, so the result does not depend on the thread count.
@@ -262,15 +266,16 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     // plane): on a separable or frictional wall the fold would move part of the normal reaction
     // off the wall's nodes, where the contact switch and the Coulomb limit act (measured: a block
     // on a mu = 0.3 floor slid 11 % fast), so there the normal velocity is mirrored only.
+    // `fold_all` folds at separable slip walls too (here the material presses on it).
     const bool bilateral = w.wall.kind == WallKind::kNoSlip ||
-                           (w.wall.kind == WallKind::kSlip && !w.wall.separable);
+                           (w.wall.kind == WallKind::kSlip && (!w.wall.separable || fold_separable));
     bool mirror_free = fold && bilateral && j >= 0;
     for (int kk = 0; mirror_free && kk < wall_count; ++kk)
       mirror_free = kk == gh.wall ||
                     walls[kk].sign * (gh.mirror[walls[kk].axis] * ctx.dx - walls[kk].level) > tolerance;
     if (!mirror_free) {
       v[a] = -u;  // odd extension of the normal velocity across the plane
-      if (report) credit(w, i, ghost, before);
+      if (report) credit(w, i, ghost, before, i);
       continue;
     }
     // Folded mirror (`mirror`): with the ghost slaved to its mirror node k, v_g = S v_k (S = -1
@@ -293,8 +298,8 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
       v[d] = -vk[d];
     }
     if (!report) continue;
-    credit(w, i, ghost, before);
-    credit(w, k, gh.mirror, before_k);
+    credit(w, i, ghost, before, i);
+    credit(w, k, gh.mirror, before_k, i);
   }
 }
 

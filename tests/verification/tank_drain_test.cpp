@@ -31,10 +31,12 @@ Real Hydrostatic(Real a, Real b, Real h) {
   return kRho * kG * ((h * b - b * b / 2) - (h * a - a * a / 2));
 }
 
-TEST(TankDrainTest, SideWallReactionStaysHydrostaticWhileDraining) {
+// Runs the drain and checks the ratios against [lo, hi] (wall and the three lower bands).
+void CheckDrain(const std::vector<std::string>& extra, Real lo, Real hi) {
   const int ppc = 3;
-  LoadedScene scene = LoadScene(testing::ScenePath("tank_drain_2d.yaml"),
-                                {"bodies.0.particles_per_cell=" + std::to_string(ppc)});
+  std::vector<std::string> overrides = {"bodies.0.particles_per_cell=" + std::to_string(ppc)};
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  LoadedScene scene = LoadScene(testing::ScenePath("tank_drain_2d.yaml"), overrides);
   ASSERT_EQ(scene.model.sensors.size(), 4u);
   const Real spacing = scene.model.dx / ppc;
   // Tributary heights of the sensor bands (node rows 0-0.75, 1-1.75, 2-2.75, 3-4.75 m).
@@ -78,12 +80,23 @@ TEST(TankDrainTest, SideWallReactionStaysHydrostaticWhileDraining) {
                 "tank %.4f\n",
                 times[w], S.n, S.hw / n, ratio, band[0], band[1], band[2], band[3], floor);
     ++checked;
-    failures += !(ratio > 0.85 && ratio < 1.05);
-    for (int k = 0; k < 3; ++k) failures += !(band[k] > 0.85 && band[k] < 1.05);
+    failures += !(ratio > lo && ratio < hi);
+    for (int k = 0; k < 3; ++k) failures += !(band[k] > lo && band[k] < hi);
     failures += !(std::abs(floor - 1) < 0.03);
   }
   EXPECT_EQ(checked, 3);
   EXPECT_EQ(failures, 0) << "see the printed ratios";
+}
+
+TEST(TankDrainTest, SideWallReactionStaysHydrostaticWhileDraining) { CheckDrain({}, 0.85, 1.05); }
+
+// domain.ghost_nodes: fold_all (docs/walls.md): the ghost nodes of the separable side wall are
+// folded into their mirrors, which removes the wall's drag on the water flowing down along it
+// (the default's 9 % deficit). Measured 2026-12-03: wall 0.988 / 0.998 / 0.999 of hydrostatic at
+// 1.5 / 2.0 / 2.5 s, the three lower bands 0.981-1.002 (default: 0.915-0.923 and 0.894-0.937).
+// The bands hold the mirror nodes' share of the reaction, which the fold credits to the ghost.
+TEST(TankDrainTest, FoldedGhostsKeepTheSideWallHydrostaticWithinThreePercent) {
+  CheckDrain({"domain.ghost_nodes=fold_all"}, 0.97, 1.03);
 }
 
 }  // namespace

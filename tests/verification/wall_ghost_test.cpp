@@ -138,6 +138,7 @@ TEST(WallGhostTest, GhostNodesKeyIsParsedAndRefused) {
   EXPECT_EQ(LoadSceneFromString(BoxScene("mirror_velocity"), "ghost_drop.yaml").model.ghost_nodes,
             GhostNodes::kMirrorVelocity);
   EXPECT_EQ(LoadSceneFromString(BoxScene("constrain"), "ghost_drop.yaml").model.ghost_nodes, GhostNodes::kConstrain);
+  EXPECT_EQ(LoadSceneFromString(BoxScene("fold_all"), "ghost_drop.yaml").model.ghost_nodes, GhostNodes::kFoldAll);
   try {
     LoadSceneFromString(BoxScene("reflect"), "ghost_drop.yaml");
     FAIL() << "an unknown ghost_nodes value must be refused";
