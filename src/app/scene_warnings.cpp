@@ -35,6 +35,22 @@ void ObstacleWarnings(const Model& m, std::vector<std::string>& out) {
             thickness = 2 * s.radius;
           } else if constexpr (std::is_same_v<S, CylinderShape>) {
             thickness = std::min(2 * s.radius, (s.top - s.base).norm());
+          } else if constexpr (std::is_same_v<S, PolygonShape>) {
+            // The smallest width across one of its edges: the largest distance of a vertex from
+            // the edge's line, minimised over the edges (the exact minimum width of a convex
+            // polygon; a plate leaning at any angle is caught, unlike by its bounding box).
+            const size_t n = s.points.size();
+            for (size_t k = 0; k < n; ++k) {
+              const auto& a = s.points[k];
+              const auto& b = s.points[(k + 1) % n];
+              const Real ex = b[0] - a[0], ey = b[1] - a[1], len = std::hypot(ex, ey);
+              if (!(len > 0)) continue;
+              Real width = 0;
+              for (const auto& p : s.points)
+                width = std::max(width, std::abs(ex * (p[1] - a[1]) - ey * (p[0] - a[0])) / len);
+              thickness = std::min(thickness, width);
+            }
+            if (m.dim == 3) thickness = std::min(thickness, s.z1 - s.z0);
           } else if constexpr (!std::is_same_v<S, PlaneShape>) {
             for (int a = 0; a < m.dim; ++a)
               thickness = std::min(thickness, ob.bounds_max[a] - ob.bounds_min[a]);

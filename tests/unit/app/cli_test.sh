@@ -48,8 +48,11 @@ bodies:
 obstacles:
   - {name: fin, shape: {box: {min: [0.5, 0], max: [0.52, 0.5]}}}
   - {name: post, shape: {box: {min: [0.605, 0], max: [0.7, 0.5]}}}
+  - {name: lean, shape: {polygon: {points: [[0.8, 0], [0.83, 0], [0.98, 0.5], [0.95, 0.5]]}}}
 YAML
-expect check_structures_line 0 "structures 2 obstacles \(0 prescribed, 0 dynamic\), 0 sensors; force log: domain, fin, post" -- "$surge" check "$work/obstacles.yaml"
+expect check_structures_line 0 "structures 3 obstacles \(0 prescribed, 0 dynamic\), 0 sensors; force log: domain, fin, post, lean" -- "$surge" check "$work/obstacles.yaml"
+# A leaning plate 0.03 m wide along x (0.0287 m across): its bounding box is 0.18 x 0.5 m.
+expect check_thin_polygon 0 "obstacles\[2\] 'lean': 0.0287 m thick, less than two cells" -- "$surge" check "$work/obstacles.yaml"
 expect check_thin_obstacle 0 "obstacles\[0\] 'fin': 0.02 m thick, less than two cells" -- "$surge" check "$work/obstacles.yaml"
 expect check_off_grid_obstacle 0 "obstacles\[1\] 'post': box faces do not lie on grid planes" -- "$surge" check "$work/obstacles.yaml"
 expect run_obstacle_forces 0 'post +peak' -- "$surge" run "$work/obstacles.yaml" --out "$work/out_obstacles" --set time.end=0.05 --set "bodies.0.velocity=[4, 0]"
