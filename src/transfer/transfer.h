@@ -59,9 +59,13 @@ void MarkWallContacts(const Model& model, const StepContext& ctx, const Particle
 // the domain, not on the wall plane) takes minus the normal velocity v_{n+1} of its mirror image
 // across the wall plane, so that the interpolated normal velocity sum_i N_i v_i vanishes on the
 // plane for every symmetric kernel (quadratic and cubic B-splines reach past the wall; linear
-// does not). On a separable wall a ghost whose mirror moves away from the wall keeps its own
-// constraint. With `report`, the momentum this moves is added to the walls' reactions. Lists
-// the ghost nodes (grid.ghosts) when `collect`, else reuses this step's list (MUSL re-map).
+// does not). With Model::ghost_nodes kMirror (bilateral walls) or kFoldAll (separable slip walls
+// too) the ghost's mass and unconstrained momentum are first folded into its mirror node (every
+// component at a no-slip wall). On a separable wall a ghost whose mirror moves away from the
+// wall keeps its own constraint. With `report`, the momentum this moves is added to the walls'
+// reactions. `collect`: the call after the grid update, which lists the ghost nodes
+// (grid.ghosts) and folds the ghosts' free predictions v_n + dt (f/m + g); otherwise the MUSL
+// re-map, which reuses the list and folds the re-mapped velocities.
 // Pre: v_{n+1} constrained by ApplyWalls at every node (UpdateGridVelocity).
 void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& grid, bool collect,
                       WallReport* report);
