@@ -254,8 +254,20 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
   const bool restart = !options.restart.empty();
   Checkpoint resume;
   if (restart) {
+    const ParticleLayout needed = state.particles.layout;
     state = State{};  // the seeded particles go before the checkpoint's arrive (peak memory)
     resume = ReadMatchingCheckpoint(scene, options);
+    const ParticleLayout& held = resume.state.particles.layout;
+    const auto missing = [&](bool need, bool have, const char* array) {
+      if (need && !have)
+        throw RunRefused("checkpoint '" + options.restart + "' has no particles/" + array +
+                         " array, which this scene's materials or tractions need");
+    };
+    missing(needed.affine, held.affine, "C");
+    missing(needed.strain, held.strain, "strain");
+    missing(needed.elastic_b, held.elastic_b, "elastic_b");
+    missing(needed.history, held.history, "history");
+    missing(needed.ext_force, held.ext_force, "ext_force");
     state = std::move(resume.state);
     resume.state = State{};
   } else {

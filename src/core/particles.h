@@ -18,18 +18,34 @@ inline constexpr int kHistorySlots = 8;
 inline constexpr int kPlasticStrainSlot = 0;
 using History = std::array<Real, kHistorySlots>;
 
+// Which of the optional particle arrays a run stores. An array a run does not use stays empty
+// (size 0) in every operation, so it costs no memory (performance issue: bytes per particle).
+// The scene builder derives the layout from the materials and tractions (ParticleLayoutFor); the
+// default, every array, is what tests and the single-point material driver use.
+struct alignas(8) ParticleLayout {
+  bool affine = true;     // C: APIC only
+  bool strain = true;     // accumulated small strain: read by linear_elastic only
+  bool elastic_b = true;  // b^e: the elastoplastic (Hencky) models
+  bool history = true;    // history slots: the plastic models and the yield-stress fluids
+  bool ext_force = true;  // particle tractions
+};
+
 // Design: material history lives in Particles (rather than in per-model SoA arrays) so that
-// reordering, compaction and checkpoints need no per-model code: every particle carries one b^e and
-// kHistorySlots scalars (136 bytes). The elastic and fluid updates never read or write them.
+// reordering, compaction and checkpoints need no per-model code: when a run has a plastic model,
+// every particle carries one b^e and kHistorySlots scalars (136 bytes); otherwise neither array is
+// allocated (ParticleLayout). The elastic and fluid updates never read or write them.
 struct Particles {
+  ParticleLayout layout;  // which optional arrays (C, strain, elastic_b, history, ext_force) are held
   // --- State: advanced by Step(), saved in checkpoints. ---
   std::vector<Vec3> x;       // position [m]                      written by GridToParticle
   std::vector<Vec3> v;       // velocity [m/s]                    written by GridToParticle
   std::vector<Mat3> C;       // APIC affine velocity [1/s]        written by GridToParticle (APIC)
+                             //   (optional: layout.affine)
   std::vector<Mat3> F;       // deformation gradient [-]          written by UpdateDeformation
   std::vector<Mat3> stress;  // Cauchy stress [Pa]                written by UpdateStress
   std::vector<Mat3> strain;  // accumulated small strain [-]      written by UpdateStress
-  // Material history (plastic models only; elastic and fluid models leave it at its initial value).
+                             //   (optional: layout.strain, linear_elastic only)
+  // Material history (optional: layout.elastic_b / layout.history, plastic models only).
   std::vector<Mat3> elastic_b;  // elastic left Cauchy-Green b^e = F^e F^eT [-] (Mast 2013 (3.30))
                                 //                                 written by UpdateStress (j2)
   std::vector<History> history; // model-defined scalars, units per slot (see kHistorySlots)
@@ -38,24 +54,26 @@ struct Particles {
   std::vector<Real> mass;         // [kg]
   std::vector<Real> volume0;      // reference volume [m^3]
   std::vector<Vec3> ext_force;    // particle traction force t*A_p [N] (Mast 2013 App. B.2.9)
+                                  //   (optional: layout.ext_force)
   std::vector<int32_t> material;  // index into Model::materials
   std::vector<int32_t> body;      // index into Model::bodies
   std::vector<int64_t> id;        // seeding order, stable across removals
 
   size_t size() const { return x.size(); }
 
+  // Resizes every array the layout holds; the others stay empty.
   void Resize(size_t n) {
     x.resize(n);
     v.resize(n);
-    C.resize(n);
+    C.resize(layout.affine ? n : 0);
     F.resize(n);
     stress.resize(n);
-    strain.resize(n);
-    elastic_b.resize(n, Mat3::Identity());
-    history.resize(n, History{});
+    strain.resize(layout.strain ? n : 0);
+    elastic_b.resize(layout.elastic_b ? n : 0, Mat3::Identity());
+    history.resize(layout.history ? n : 0, History{});
     mass.resize(n);
     volume0.resize(n);
-    ext_force.resize(n);
+    ext_force.resize(layout.ext_force ? n : 0);
     material.resize(n);
     body.resize(n);
     id.resize(n);
@@ -65,19 +83,25 @@ struct Particles {
   void Move(size_t to, size_t from) {
     x[to] = x[from];
     v[to] = v[from];
-    C[to] = C[from];
+    if (layout.affine) C[to] = C[from];
     F[to] = F[from];
     stress[to] = stress[from];
-    strain[to] = strain[from];
-    elastic_b[to] = elastic_b[from];
-    history[to] = history[from];
+    if (layout.strain) strain[to] = strain[from];
+    if (layout.elastic_b) elastic_b[to] = elastic_b[from];
+    if (layout.history) history[to] = history[from];
     mass[to] = mass[from];
     volume0[to] = volume0[from];
-    ext_force[to] = ext_force[from];
+    if (layout.ext_force) ext_force[to] = ext_force[from];
     material[to] = material[from];
     body[to] = body[from];
     id[to] = id[from];
   }
 };
+
+// Particles is the layout and these 14 arrays: checkpoint.cpp and reorder.cpp handle each one, and
+// assert this so that a new array is added there too.
+inline constexpr size_t kParticleArrays = 14;
+inline constexpr size_t kParticlesSize =
+    sizeof(ParticleLayout) + kParticleArrays * sizeof(std::vector<Real>);
 
 }  // namespace surge

@@ -63,7 +63,6 @@ struct SparseGrid {
   std::vector<Vec3> field_velocity_new;  // v_i,f at t_{n+1} after contact and walls [m/s]
 
   // --- Scratch reused by RebuildGrid (no allocation per step after warm-up). ---
-  std::vector<Vec3i> particle_block_coord;
   std::vector<std::vector<BlockRequest>> chunk_requests;
   std::vector<BlockRequest> requests;
   std::vector<uint32_t> chunk_cursor;

@@ -37,7 +37,7 @@ static_assert(sizeof(History) == kHistorySlots * sizeof(double), "History must b
 static_assert(std::is_same_v<Real, double>, "checkpoints store Real as float64");
 // Particles has exactly the 14 arrays written and read below: a new array must be added here
 // (and to docs/results-format.md, "Checkpoints") or restarts silently lose it.
-static_assert(sizeof(Particles) == 14 * sizeof(std::vector<Real>),
+static_assert(sizeof(Particles) == kParticlesSize,
               "Particles changed: update WriteCheckpoint/ReadCheckpoint");
 
 using Handle = H5Handle;  // io/h5_handle.h
@@ -395,15 +395,15 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
       const hid_t l = g.get();
       WriteDoubles(l, "x", P.x.data(), n, 3, tmp);
       WriteDoubles(l, "v", P.v.data(), n, 3, tmp);
-      WriteDoubles(l, "C", P.C.data(), n, 9, tmp);
+      if (P.layout.affine) WriteDoubles(l, "C", P.C.data(), n, 9, tmp);
       WriteDoubles(l, "F", P.F.data(), n, 9, tmp);
       WriteDoubles(l, "stress", P.stress.data(), n, 9, tmp);
-      WriteDoubles(l, "strain", P.strain.data(), n, 9, tmp);
-      WriteDoubles(l, "elastic_b", P.elastic_b.data(), n, 9, tmp);
-      WriteDoubles(l, "history", P.history.data(), n, kHistorySlots, tmp);
+      if (P.layout.strain) WriteDoubles(l, "strain", P.strain.data(), n, 9, tmp);
+      if (P.layout.elastic_b) WriteDoubles(l, "elastic_b", P.elastic_b.data(), n, 9, tmp);
+      if (P.layout.history) WriteDoubles(l, "history", P.history.data(), n, kHistorySlots, tmp);
       WriteDoubles(l, "mass", P.mass.data(), n, 0, tmp);
       WriteDoubles(l, "volume0", P.volume0.data(), n, 0, tmp);
-      WriteDoubles(l, "ext_force", P.ext_force.data(), n, 3, tmp);
+      if (P.layout.ext_force) WriteDoubles(l, "ext_force", P.ext_force.data(), n, 3, tmp);
       WriteArray(l, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, P.material.data(), n, 0, tmp);
       WriteArray(l, "body", H5T_STD_I32LE, H5T_NATIVE_INT32, P.body.data(), n, 0, tmp);
       WriteArray(l, "id", H5T_STD_I64LE, H5T_NATIVE_INT64, P.id.data(), n, 0, tmp);
@@ -515,15 +515,20 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
     const hid_t d = H5T_NATIVE_DOUBLE;
     ReadArray(l, "x", d, n, 3, P.x, path);
     ReadArray(l, "v", d, n, 3, P.v, path);
-    ReadArray(l, "C", d, n, 9, P.C, path);
+    P.layout.affine = H5Lexists(l, "C", H5P_DEFAULT) > 0;
+    if (P.layout.affine) ReadArray(l, "C", d, n, 9, P.C, path);
     ReadArray(l, "F", d, n, 9, P.F, path);
     ReadArray(l, "stress", d, n, 9, P.stress, path);
-    ReadArray(l, "strain", d, n, 9, P.strain, path);
-    ReadArray(l, "elastic_b", d, n, 9, P.elastic_b, path);
-    ReadArray(l, "history", d, n, kHistorySlots, P.history, path);
+    P.layout.strain = H5Lexists(l, "strain", H5P_DEFAULT) > 0;
+    if (P.layout.strain) ReadArray(l, "strain", d, n, 9, P.strain, path);
+    P.layout.elastic_b = H5Lexists(l, "elastic_b", H5P_DEFAULT) > 0;
+    if (P.layout.elastic_b) ReadArray(l, "elastic_b", d, n, 9, P.elastic_b, path);
+    P.layout.history = H5Lexists(l, "history", H5P_DEFAULT) > 0;
+    if (P.layout.history) ReadArray(l, "history", d, n, kHistorySlots, P.history, path);
     ReadArray(l, "mass", d, n, 0, P.mass, path);
     ReadArray(l, "volume0", d, n, 0, P.volume0, path);
-    ReadArray(l, "ext_force", d, n, 3, P.ext_force, path);
+    P.layout.ext_force = H5Lexists(l, "ext_force", H5P_DEFAULT) > 0;
+    if (P.layout.ext_force) ReadArray(l, "ext_force", d, n, 3, P.ext_force, path);
     ReadArray(l, "material", H5T_NATIVE_INT32, n, 0, P.material, path);
     ReadArray(l, "body", H5T_NATIVE_INT32, n, 0, P.body, path);
     ReadArray(l, "id", H5T_NATIVE_INT64, n, 0, P.id, path);

@@ -413,9 +413,9 @@ struct ResultsWriter::Impl {
   hsize_t energy_rows = 0;
   std::vector<EnergyRecord> pending;
   std::vector<XdmfSnapshot> written;
-  // Per-snapshot scratch, kept between snapshots so that writing allocates only on growth.
-  std::vector<double> position, velocity, stress;
-  std::vector<double> pressure, von_mises, strain_volumetric, strain_equivalent, plastic_strain;
+  // Per-snapshot scratch for one derived field at a time (at most 6 doubles per particle, the
+  // stress), kept between snapshots so that writing allocates only on growth.
+  std::vector<double> scratch;
   bool closed = false;
   // Force series: pending rows per structure, rows already in the .h5, one CSV per structure.
   std::string out_dir;
@@ -831,30 +831,6 @@ void ResultsWriter::WriteSnapshot(const State& state) {
   if (I.closed) throw IoError("WriteSnapshot after Close on '" + I.h5 + "'");
   const Particles& P = state.particles;
   const size_t n = P.size();
-  I.position.resize(3 * n);
-  I.velocity.resize(3 * n);
-  I.stress.resize(6 * n);
-  I.pressure.resize(n);
-  I.von_mises.resize(n);
-  I.strain_volumetric.resize(n);
-  I.strain_equivalent.resize(n);
-  I.plastic_strain.resize(n);
-  // Independent per particle, so the output does not depend on the thread count.
-  ParallelFor(n, 4096, [&](size_t p) {
-    for (int d = 0; d < 3; ++d) {
-      I.position[3 * p + d] = P.x[p][d];
-      I.velocity[3 * p + d] = P.v[p][d];
-    }
-    const Mat3& s = P.stress[p];
-    // VTK/ParaView order xx yy zz xy yz xz, so ParaView's component labels are right.
-    const double voigt[6] = {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2)};
-    std::copy(voigt, voigt + 6, &I.stress[6 * p]);
-    I.pressure[p] = -s.trace() / 3.0;                        // > 0 in compression
-    I.von_mises[p] = std::sqrt(1.5 * Dev(s).squaredNorm());  // q = sqrt(3/2 s:s)
-    StrainInvariants(P.F[p], I.strain_volumetric[p], I.strain_equivalent[p]);
-    I.plastic_strain[p] = P.history[p][kPlasticStrainSlot];  // 0 for elastic and fluid models
-  });
-
   char name[16];
   std::snprintf(name, sizeof name, "%06d", int(I.written.size()));
   {  // the group is closed before Commit closes the file
@@ -862,20 +838,49 @@ void ResultsWriter::WriteSnapshot(const State& state) {
     Require(g.ok(), std::string("create snapshot ") + name, I.h5);
     WriteScalarAttr(g.get(), "time", H5T_NATIVE_DOUBLE, state.time, I.h5);
     WriteScalarAttr(g.get(), "step", H5T_NATIVE_INT64, int64_t{state.step}, I.h5);
-    const auto write_doubles = [&](const char* dataset, const std::vector<double>& v, size_t cols) {
-      WriteArray(g.get(), dataset, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, v.data(), n, cols, I.h5);
+    const auto write_doubles = [&](const char* dataset, const double* v, size_t cols) {
+      WriteArray(g.get(), dataset, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, v, n, cols, I.h5);
     };
-    write_doubles("position", I.position, 3);
-    write_doubles("velocity", I.velocity, 3);
-    write_doubles("stress", I.stress, 6);
-    write_doubles("pressure", I.pressure, 0);
-    write_doubles("von_mises", I.von_mises, 0);
-    write_doubles("strain_volumetric", I.strain_volumetric, 0);
-    write_doubles("strain_equivalent", I.strain_equivalent, 0);
+    // A derived field of `cols` doubles per particle (0: a scalar), filled into the scratch by
+    // fill(p, out) and written. Independent per particle: the output does not depend on threads.
+    const auto write_derived = [&](const char* dataset, size_t cols, auto fill) {
+      const size_t stride = std::max<size_t>(cols, 1);
+      I.scratch.resize(stride * n);
+      double* out = I.scratch.data();
+      ParallelFor(n, 4096, [&](size_t p) { fill(p, out + stride * p); });
+      write_doubles(dataset, out, cols);
+    };
+    static_assert(sizeof(Vec3) == 3 * sizeof(double), "x and v are written as n x 3 doubles");
+    write_doubles("position", n ? P.x[0].data() : nullptr, 3);
+    write_doubles("velocity", n ? P.v[0].data() : nullptr, 3);
+    write_derived("stress", 6, [&](size_t p, double* out) {
+      const Mat3& s = P.stress[p];
+      // VTK/ParaView order xx yy zz xy yz xz, so ParaView's component labels are right.
+      const double voigt[6] = {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2)};
+      std::copy(voigt, voigt + 6, out);
+    });
+    write_derived("pressure", 0, [&](size_t p, double* out) {
+      *out = -P.stress[p].trace() / 3.0;  // > 0 in compression
+    });
+    write_derived("von_mises", 0, [&](size_t p, double* out) {
+      *out = std::sqrt(1.5 * Dev(P.stress[p]).squaredNorm());  // q = sqrt(3/2 s:s)
+    });
+    {  // both strain invariants from one eigen-solve per particle: two halves of the scratch
+      I.scratch.resize(2 * n);
+      double* volumetric = I.scratch.data();
+      double* equivalent = volumetric + n;
+      ParallelFor(n, 4096,
+                  [&](size_t p) { StrainInvariants(P.F[p], volumetric[p], equivalent[p]); });
+      write_doubles("strain_volumetric", volumetric, 0);
+      write_doubles("strain_equivalent", equivalent, 0);
+    }
     WriteArray(g.get(), "material", H5T_NATIVE_INT32, H5T_STD_I32LE, P.material.data(), n, 0, I.h5);
     WriteArray(g.get(), "body", H5T_NATIVE_INT32, H5T_STD_I32LE, P.body.data(), n, 0, I.h5);
     WriteArray(g.get(), "id", H5T_NATIVE_INT64, H5T_STD_I64LE, P.id.data(), n, 0, I.h5);
-    write_doubles("plastic_strain", I.plastic_strain, 0);
+    // 0 for elastic and fluid models (no history array when the run has no plastic model)
+    write_derived("plastic_strain", 0, [&](size_t p, double* out) {
+      *out = P.layout.history ? P.history[p][kPlasticStrainSlot] : 0.0;
+    });
   }
   I.WriteEnergyRows();
   I.WriteForceRows();

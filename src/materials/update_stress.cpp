@@ -51,7 +51,6 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
-                       P.strain[p] += Sym(f - Mat3::Identity());
                        P.stress[p] = NeoHookeanStress(params, P.F[p]);
                      });
                    },
@@ -62,7 +61,6 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
-                       P.strain[p] += Sym(f - Mat3::Identity());
                        PlasticUpdate(params, f, P.F[p].determinant(), P.elastic_b[p],
                                      P.history[p], P.stress[p]);
                      });
@@ -72,7 +70,6 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
-                       P.strain[p] += Sym(f - Mat3::Identity());
                        P.stress[p] = NewtonianFluidStress(params, P.F[p].determinant(),
                                                           velocity_gradient[p]);  // (6.1)-(6.2)
                      });
@@ -82,7 +79,6 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
-                       P.strain[p] += Sym(f - Mat3::Identity());
                        BinghamFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p], dt,
                                           P.history[p], P.stress[p]);  // A3D (7.37)
                      });
@@ -92,7 +88,6 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
-                       P.strain[p] += Sym(f - Mat3::Identity());
                        FrictionalFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p],
                                              dt, P.history[p], P.stress[p]);  // A3D (7.38)
                      });
@@ -144,6 +139,26 @@ void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_
       material.params);
 }
 
+ParticleLayout ParticleLayoutFor(const Model& model, bool tractions) {
+  ParticleLayout layout{model.transfer == TransferScheme::kApic, false, false, false, tractions};
+  for (const Material& m : model.materials) {
+    std::visit(
+        [&](const auto& p) {
+          using P = std::decay_t<decltype(p)>;
+          layout.strain |= std::is_same_v<P, LinearElasticParams>;  // (small-strain Hooke)
+          layout.elastic_b |= kIsElastoplastic<P>;                 // b^e, Table 3.4
+          layout.history |= kIsElastoplastic<P> || std::is_same_v<P, BinghamFluidParams> ||
+                            std::is_same_v<P, FrictionalFluidParams>;
+        },
+        m.params);
+  }
+  return layout;
+}
+
+namespace {
+const Mat3 kNoStrain = Mat3::Zero();  // models other than linear_elastic ignore the strain
+}  // namespace
+
 Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,
                   const Particles& P) {
   Real total = 0;
@@ -153,7 +168,8 @@ Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,
     ParallelChunks(g.end - g.begin, [&](size_t c, size_t b, size_t e) {
       Real sum = 0;
       for (size_t p = g.begin + b; p < g.begin + e; ++p)
-        sum += StrainEnergyDensity(mat, P.F[p], P.stress[p], P.strain[p]) * P.volume0[p];
+        sum += StrainEnergyDensity(mat, P.F[p], P.stress[p],
+                                   P.strain.empty() ? kNoStrain : P.strain[p]) * P.volume0[p];
       partial[c] = sum;
     });
     for (Real s : partial) total += s;

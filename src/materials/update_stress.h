@@ -9,8 +9,9 @@
 
 namespace surge {
 
-// F_{n+1} = (I + dt L) F_n (2.18), then the group's constitutive update. Reads L, F, stress,
-// strain, elastic_b, history; writes F, stress, strain and (plastic models) elastic_b, history.
+// F_{n+1} = (I + dt L) F_n (2.18), then the group's constitutive update. Reads L, F, stress and
+// what the group's model keeps (linear_elastic: strain; plastic models: elastic_b, history; yield-
+// stress fluids: history), writes F, stress and that state.
 void UpdateStress(const Model& model, const StepContext& ctx,
                   const std::vector<Mat3>& velocity_gradient,
                   const std::vector<MaterialGroup>& groups, Particles& particles);
@@ -19,6 +20,12 @@ void UpdateStress(const Model& model, const StepContext& ctx,
 // start): b^e from the elastic compliance for J2, identity otherwise; history slots zero.
 void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_b,
                     History& history);
+
+// The optional particle arrays a run with these materials needs (Particles::layout): C for APIC
+// transfers, strain for
+// linear_elastic, b^e for the elastoplastic models, history for those and the yield-stress fluids,
+// ext_force when a body has tractions.
+ParticleLayout ParticleLayoutFor(const Model& model, bool tractions);
 
 // Stored elastic energy sum psi V0 [J] (per metre of thickness in 2-D), summed in fixed chunks.
 Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,

@@ -38,26 +38,27 @@ double ReadNumber(const char* path) {
 
 }  // namespace
 
-double BytesPerParticle() {
+double BytesPerParticle(const ParticleLayout& layout) {
   using P = Particles;
-  // State: every Particles array.
-  double b = Elem<decltype(P::x)>() + Elem<decltype(P::v)>() + Elem<decltype(P::C)>() +
-             Elem<decltype(P::F)>() + Elem<decltype(P::stress)>() + Elem<decltype(P::strain)>() +
-             Elem<decltype(P::elastic_b)>() + Elem<decltype(P::history)>() +
-             Elem<decltype(P::mass)>() + Elem<decltype(P::volume0)>() +
-             Elem<decltype(P::ext_force)>() + Elem<decltype(P::material)>() +
+  // State: every Particles array the layout holds.
+  double b = Elem<decltype(P::x)>() + Elem<decltype(P::v)>() + Elem<decltype(P::F)>() + Elem<decltype(P::stress)>() + Elem<decltype(P::mass)>() +
+             Elem<decltype(P::volume0)>() + Elem<decltype(P::material)>() +
              Elem<decltype(P::body)>() + Elem<decltype(P::id)>();
+  if (layout.affine) b += Elem<decltype(P::C)>();
+  if (layout.strain) b += Elem<decltype(P::strain)>();
+  if (layout.elastic_b) b += Elem<decltype(P::elastic_b)>();
+  if (layout.history) b += Elem<decltype(P::history)>();
+  if (layout.ext_force) b += Elem<decltype(P::ext_force)>();
   // Workspace per-particle scratch.
   using W = Workspace;
   b += Elem<decltype(W::velocity_gradient)>() + Elem<decltype(W::x_new)>() +
        Elem<decltype(W::exit_flag)>() + Elem<decltype(W::reorder)>();
   // Grid binning.
   using G = SparseGrid;
-  b += Elem<decltype(G::particle_block)>() + Elem<decltype(G::sorted)>() +
-       Elem<decltype(G::particle_block_coord)>();
-  // Results writer snapshot scratch (hdf5_writer.cpp): position, velocity (3), stress (6) and
-  // five scalars, float64.
-  b += (3 + 3 + 6 + 5) * sizeof(double);
+  b += Elem<decltype(G::particle_block)>() + Elem<decltype(G::sorted)>();
+  // Results writer snapshot scratch (hdf5_writer.cpp): one derived field at a time, at most the
+  // stress (6 float64).
+  b += 6 * sizeof(double);
   return b;
 }
 
@@ -74,11 +75,12 @@ double BytesPerBlock(int fields) {
   return kBlockNodes * (node + fields * field) + topology;
 }
 
-MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields) {
+MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields,
+                              const ParticleLayout& layout) {
   MemoryEstimate m;
   m.particles = particles;
   m.grid_blocks = grid_blocks;
-  m.particle_bytes = particles * BytesPerParticle();
+  m.particle_bytes = particles * BytesPerParticle(layout);
   m.grid_bytes = grid_blocks * BytesPerBlock(fields);
   return m;
 }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/math.h"
+#include "core/particles.h"
 
 namespace surge {
 
@@ -18,14 +19,15 @@ struct MemoryEstimate {
 };
 
 // Bytes held per particle during a run (Particles, Workspace and SparseGrid per-particle arrays,
-// the snapshot scratch of the results writer).
-double BytesPerParticle();
+// the snapshot scratch of the results writer), for the optional arrays of `layout`.
+double BytesPerParticle(const ParticleLayout& layout);
 // Bytes of node fields per active block with `fields` per-body velocity fields (0 without
 // body_contact).
 double BytesPerBlock(int fields);
 
 // Pre: particles, grid_blocks >= 0.
-MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields);
+MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields,
+                              const ParticleLayout& layout);
 
 // Blocks of 8^3 nodes covering the box [lo, hi] [m] at cell size dx [m], one block more on each
 // side for the stencils that cross a block face; z is one block in 2-D. Pre: dx > 0.

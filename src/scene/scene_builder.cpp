@@ -52,17 +52,18 @@ std::string Point(const Vec3& x, int dim) {
 // domain) needs more memory than the machine has available (memory_estimate.h). `qualifier`
 // ("at most ") says that the count is an upper bound.
 void CheckMemory(const SceneSpec& spec, double particles, Aabb box, int fields,
-                 const std::string& qualifier) {
+                 const ParticleLayout& layout, const std::string& qualifier) {
   box.min = box.min.cwiseMax(spec.domain.min);
   box.max = box.max.cwiseMin(spec.domain.max);
   const MemoryEstimate m = EstimateMemory(
-      particles, BlocksCovering(box.min, box.max, spec.grid.cell_size, spec.dimension), fields);
+      particles, BlocksCovering(box.min, box.max, spec.grid.cell_size, spec.dimension), fields,
+      layout);
   const double available = AvailableMemory();
   if (m.total() <= available) return;
   const SourceLoc& loc = spec.bodies.empty() ? SourceLoc{} : spec.bodies.front().loc;
   Fail(loc, "bodies",
        "the run needs about " + FormatBytes(m.total()) + " of memory (" + qualifier +
-           Num(std::round(particles)) + " particles x " + Num(BytesPerParticle()) + " bytes + " +
+           Num(std::round(particles)) + " particles x " + Num(BytesPerParticle(layout)) + " bytes + " +
            Num(m.grid_blocks) + " grid blocks x " + Num(BytesPerBlock(fields)) +
            " bytes), more than the " + FormatBytes(available) +
            " available on this machine; use a larger grid.cell_size or fewer particles_per_cell");
@@ -377,6 +378,10 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   BuildAnalysis(spec, model);
 
   // Memory (issue 9): refuse a scene that cannot fit before seeding allocates anything. The
+  // The optional particle arrays the materials and tractions need (Particles::layout).
+  const bool tractions = std::any_of(spec.bodies.begin(), spec.bodies.end(),
+                                     [](const BodySpec& b) { return !b.tractions.empty(); });
+  const ParticleLayout layout = ParticleLayoutFor(model, tractions);
   // lattice points of each region's bounding box bound its particles from above (exactly for
   // boxes); mesh regions are counted after seeding, below.
   {
@@ -393,7 +398,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
       box.max = box.max.cwiseMax(r.max);
     }
     if (particles > 0) {
-      CheckMemory(spec, particles, box, model.field_count, "at most ");
+      CheckMemory(spec, particles, box, model.field_count, layout, "at most ");
     }
   }
 
@@ -420,7 +425,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
         box.max = box.max.cwiseMax(x);
       }
     }
-    CheckMemory(spec, total, box, model.field_count, "");
+    CheckMemory(spec, total, box, model.field_count, layout, "");
   }
 
   // Lay the particles out grouped by material, bodies in file order within a group: the same
@@ -433,7 +438,10 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
                                          o.motion.angular_velocity});
   }
   Particles& P = state.particles;
+  P.layout = layout;
   P.Resize(static_cast<size_t>(total));
+  Mat3 unused_b;  // InitialHistory's outputs for a layout without b^e or history
+  History unused_history;
   size_t next = 0;
   for (size_t m = 0; m < spec.materials.size(); ++m) {
     const size_t begin = next;
@@ -443,14 +451,16 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
       for (size_t k = 0; k < s.x.size(); ++k, ++next) {
         P.x[next] = s.x[k];
         P.v[next] = spec.bodies[b].velocity;
-        P.C[next] = Mat3::Zero();
+        if (P.layout.affine) P.C[next] = Mat3::Zero();
         P.F[next] = Mat3::Identity();
         P.stress[next] = s.stress[k];
-        P.strain[next] = Mat3::Zero();
-        InitialHistory(model.materials[m], s.stress[k], P.elastic_b[next], P.history[next]);
+        if (P.layout.strain) P.strain[next] = Mat3::Zero();
+        InitialHistory(model.materials[m], s.stress[k],
+                       P.layout.elastic_b ? P.elastic_b[next] : unused_b,
+                       P.layout.history ? P.history[next] : unused_history);
         P.mass[next] = s.mass;
         P.volume0[next] = s.volume0;
-        P.ext_force[next] = s.ext_force[k];
+        if (P.layout.ext_force) P.ext_force[next] = s.ext_force[k];
         P.material[next] = static_cast<int32_t>(m);
         P.body[next] = static_cast<int32_t>(b);
         P.id[next] = first_id[b] + static_cast<int64_t>(k);

@@ -43,7 +43,7 @@ void ReorderParticlesStage(const Model&, const StepContext&, State& s, Workspace
   // Apply new[i] = old[order[i]] array by array: a parallel gather into a fresh array that then
   // replaces the old one. It streams each array once and holds one extra array at a time (the
   // serial cycle-following Move it replaces touched all 14 arrays per particle, on one thread).
-  static_assert(sizeof(Particles) == 14 * sizeof(std::vector<Real>),
+  static_assert(sizeof(Particles) == kParticlesSize,
                 "a new Particles array must be permuted here too");
   for (auto* a : {&P.x, &P.v, &P.ext_force}) Permute(*a, order);
   for (auto* a : {&P.C, &P.F, &P.stress, &P.strain, &P.elastic_b}) Permute(*a, order);

@@ -86,7 +86,8 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
     Vec3 fext = Vec3::Zero();
     if constexpr (kFull) {
       neg_vs = -(P.volume0[p] * P.F[p].determinant()) * P.stress[p];
-      fext = ctx.ramp * P.ext_force[p];  // particle tractions (App. B.2.9), ramped (App. B.2.3)
+      if (P.layout.ext_force)
+        fext = ctx.ramp * P.ext_force[p];  // particle tractions (App. B.2.9), ramped (App. B.2.3)
     }
     // Lane vectors of the single-field path: (m, m v), the columns of mC as (0, mC[:,c]), the
     // columns of -V sigma as (S[:,c], 0) and (f_ext, 0), each as two Real2.

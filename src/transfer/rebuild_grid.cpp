@@ -8,11 +8,25 @@
 namespace surge {
 namespace {
 
+// Block coordinate of the block owning the stencil base node of x, and the mask of the axes along
+// which the stencil crosses into the next block.
+template <int kDim, class K>
+Vec3i OwnerBlock(const Vec3& x, Real inv_dx, uint8_t& mask) {
+  Vec3i block(0, 0, 0);
+  mask = 0;
+  for (int d = 0; d < kDim; ++d) {
+    const int base = K::Base(x[d] * inv_dx);
+    block[d] = base >> kBlockBits;  // arithmetic shift = floor division (C++20)
+    const int local = base - (block[d] << kBlockBits);
+    if (local + K::kWidth - 1 >= kBlockDim) mask |= uint8_t(1u << d);
+  }
+  return block;
+}
+
 // Pass 1: owner block and crossing mask of every particle; per-chunk deduplicated requests.
 template <int kDim, class K>
 void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) {
   const size_t n = particles.size();
-  grid.particle_block_coord.resize(n);
   grid.chunk_requests.resize(kReductionChunks);
   ParallelChunks(n, [&](size_t chunk, size_t begin, size_t end) {
     auto& out = grid.chunk_requests[chunk];
@@ -24,15 +38,8 @@ void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) 
     BlockRequest last;
     bool have_last = false;
     for (size_t p = begin; p < end; ++p) {
-      Vec3i block(0, 0, 0);
       uint8_t mask = 0;
-      for (int d = 0; d < kDim; ++d) {
-        const int base = K::Base(particles.x[p][d] * inv_dx);
-        block[d] = base >> kBlockBits;  // arithmetic shift = floor division (C++20)
-        const int local = base - (block[d] << kBlockBits);
-        if (local + K::kWidth - 1 >= kBlockDim) mask |= uint8_t(1u << d);
-      }
-      grid.particle_block_coord[p] = block;
+      const Vec3i block = OwnerBlock<kDim, K>(particles.x[p], inv_dx, mask);
       if (have_last && last.block == block && last.upper == mask) continue;
       last = BlockRequest{block, mask};
       have_last = true;
@@ -48,6 +55,26 @@ void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) 
   for (const auto& c : grid.chunk_requests) grid.requests.insert(grid.requests.end(), c.begin(), c.end());
 }
 
+// Pass 2, after the topology is built: the index of every particle's owner block. The block
+// coordinates are recomputed in slices of kSlice (a stack buffer) rather than kept from pass 1, so
+// binning holds no per-particle coordinate array (12 bytes per particle).
+template <int kDim, class K>
+void FindOwnerBlocks(const Particles& particles, Real inv_dx, SparseGrid& grid) {
+  const size_t n = particles.size();
+  grid.particle_block.resize(n);
+  ParallelChunks(n, [&](size_t, size_t begin, size_t end) {
+    constexpr size_t kSlice = 512;
+    Vec3i blocks[kSlice];
+    for (size_t first = begin; first < end; first += kSlice) {
+      const size_t count = std::min(kSlice, end - first);
+      uint8_t mask;
+      for (size_t i = 0; i < count; ++i)
+        blocks[i] = OwnerBlock<kDim, K>(particles.x[first + i], inv_dx, mask);
+      LookupBlocks(grid, blocks, count, grid.particle_block.data() + first);
+    }
+  });
+}
+
 }  // namespace
 
 void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& grid) {
@@ -57,9 +84,9 @@ void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& gri
   });
   BuildTopology(grid.requests, grid);
 
-  const size_t n = particles.size();
-  grid.particle_block.resize(n);
-  LookupBlocks(grid, grid.particle_block_coord.data(), n, grid.particle_block.data());
+  DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
+    FindOwnerBlocks<kDim, K>(particles, inv_dx, grid);
+  });
 
   BinParticles(grid);
 }

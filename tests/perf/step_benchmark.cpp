@@ -196,7 +196,7 @@ size_t StateBytes(const State& state, const Workspace& w) {
   b += Bytes(g.block_origin) + Bytes(g.neighbor) + Bytes(g.particle_block) +
        Bytes(g.block_begin) + Bytes(g.sorted) + Bytes(g.mass) + Bytes(g.momentum) +
        Bytes(g.force) + Bytes(g.velocity) + Bytes(g.velocity_new) + Bytes(g.reaction) +
-       Bytes(g.particle_block_coord) + Bytes(g.requests) + Bytes(g.chunk_cursor) +
+       Bytes(g.requests) + Bytes(g.chunk_cursor) +
        Bytes(g.wall_partials);
   for (const auto& c : g.colour) b += Bytes(c);
   for (const auto& c : g.chunk_requests) b += Bytes(c);

@@ -275,6 +275,37 @@ void ReplaceWithArrayAttr(const std::string& file, const char* loc, const char* 
 // corrupt file gave a stack or heap overflow; now an IoError naming the file (fuzz_io checks).
 // The files are edited through HDF5, so their checksum no longer matches: read without it, to
 // test what lies behind it.
+// A FLIP run without linear_elastic, plastic models or tractions holds no C, strain, b^e, history
+// or ext_force (Particles::layout): the checkpoint stores only the arrays held, and reading it gives
+// the same layout back with the others empty.
+TEST_F(CheckpointTest, OptionalArraysRoundTripByLayout) {
+  for (int mask = 0; mask < 32; ++mask) {
+    Checkpoint c = FullCheckpoint(6);
+    Particles& P = c.state.particles;
+    P.layout = ParticleLayout{bool(mask & 16), bool(mask & 1), bool(mask & 2), bool(mask & 4),
+                              bool(mask & 8)};
+    P.Resize(3);  // drops the arrays the layout does not hold
+    ASSERT_EQ(P.strain.size(), (mask & 1) ? 3u : 0u);
+    ASSERT_EQ(P.ext_force.size(), (mask & 8) ? 3u : 0u);
+    c.state.groups = {{0, 0, 3}};
+    c.bulk_viscosity_q.resize(3);
+    c.bulk_viscosity_id.resize(3);
+    const std::string path = (dir_ / ("lean" + std::to_string(mask) + ".h5")).string();
+    WriteCheckpoint(path, c);
+    const Checkpoint r = ReadCheckpoint(path);
+    const Particles& Q = r.state.particles;
+    EXPECT_EQ(Q.layout.affine, P.layout.affine) << mask;
+    EXPECT_EQ(Q.layout.strain, P.layout.strain) << mask;
+    EXPECT_EQ(Q.layout.elastic_b, P.layout.elastic_b) << mask;
+    EXPECT_EQ(Q.layout.history, P.layout.history) << mask;
+    EXPECT_EQ(Q.layout.ext_force, P.layout.ext_force) << mask;
+    EXPECT_TRUE(SameBytes(P.x, Q.x) && SameBytes(P.C, Q.C) && SameBytes(P.strain, Q.strain) &&
+                SameBytes(P.elastic_b, Q.elastic_b) && SameBytes(P.history, Q.history) &&
+                SameBytes(P.ext_force, Q.ext_force) && SameBytes(P.id, Q.id))
+        << mask;
+  }
+}
+
 TEST_F(CheckpointTest, MalformedShapesAreRefusedNamingThePath) {
   const Checkpoint c = FullCheckpoint(4);
   const auto expect_error = [](const std::string& path) {

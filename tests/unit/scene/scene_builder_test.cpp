@@ -52,7 +52,6 @@ TEST(SceneBuilderTest, BoxGivesExactLatticeCountAndMass) {
     EXPECT_EQ(P.C[p], Mat3::Zero());
     EXPECT_EQ(P.stress[p], Mat3::Zero());
     EXPECT_EQ(P.strain[p], Mat3::Zero());
-    EXPECT_EQ(P.ext_force[p], Vec3::Zero());
     EXPECT_EQ(P.id[p], static_cast<int64_t>(p));
     EXPECT_EQ(P.volume0[p], 0.125 * 0.125 * 0.125);
   }
@@ -222,6 +221,56 @@ TEST(SceneBuilderTest, TractionsActOnTheOutermostLayer) {
   }
   EXPECT_NEAR(sum_x.y(), -1000.0 * 2.0 * 0.5, 1e-9);  // traction x face area (2 x 0.5)
   EXPECT_NEAR(sum_y.y(), 500.0 * 1.0 * 0.5, 1e-9);
+}
+
+// Only the arrays the materials and tractions need are allocated (performance issue: bytes per
+// particle): linear_elastic keeps the small strain, the plastic models b^e and history, the
+// yield-stress fluids history, a body with tractions ext_force; APIC keeps C, FLIP does not.
+TEST(SceneBuilderTest, ParticleArraysFollowTheMaterials) {
+  struct Case {
+    std::string material, extra;
+    bool strain, elastic_b, history, ext_force;
+  };
+  const std::vector<Case> cases = {
+      {"{model: linear_elastic, density: 2000, bulk_modulus: 1.0e7, shear_modulus: 5.0e6}", "",
+       true, false, false, false},
+      {"{model: neo_hookean, density: 2000, bulk_modulus: 1.0e7, shear_modulus: 5.0e6}",
+       "    tractions: [{face: y+, traction: [0, -200]}]\n", false, false, false, true},
+      {"{model: drucker_prager_smooth_cap, density: 2000, bulk_modulus: 8.33e6, "
+       "shear_modulus: 3.85e6, friction_angle_deg: 30, yield_stress: 10}",
+       "", false, true, true, false},
+      {"{model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e6, viscosity: 1.0e-3}", "", false,
+       false, false, false},
+      {"{model: bingham_fluid, density: 1000, bulk_modulus: 2.0e6, viscosity: 1.0, yield_stress: 10}",
+       "", false, false, true, false},
+  };
+  for (const Case& c : cases) {
+    std::string text = OneBody(2, "{box: {min: [0, 0], max: [1, 0.5]}}", 0.1, c.extra);
+    const std::string le =
+        "{model: linear_elastic, density: 2000, bulk_modulus: 1.0e7, shear_modulus: 5.0e6}";
+    text.replace(text.find(le), le.size(), c.material);
+    const LoadedScene s = LoadSceneFromString(text, "s.yaml");
+    const Particles& P = s.state.particles;
+    SCOPED_TRACE(c.material);
+    ASSERT_EQ(P.size(), 200u);
+    EXPECT_EQ(P.layout.affine, s.model.transfer == TransferScheme::kApic);
+    EXPECT_EQ(P.C.size(), P.layout.affine ? P.size() : 0u);
+    EXPECT_EQ(P.layout.strain, c.strain);
+    EXPECT_EQ(P.layout.elastic_b, c.elastic_b);
+    EXPECT_EQ(P.layout.history, c.history);
+    EXPECT_EQ(P.layout.ext_force, c.ext_force);
+    EXPECT_EQ(P.strain.size(), c.strain ? P.size() : 0u);
+    EXPECT_EQ(P.elastic_b.size(), c.elastic_b ? P.size() : 0u);
+    EXPECT_EQ(P.history.size(), c.history ? P.size() : 0u);
+    EXPECT_EQ(P.ext_force.size(), c.ext_force ? P.size() : 0u);
+  }
+  for (const char* transfer : {"apic", "flip", "pic_flip"}) {
+    std::string text = OneBody(2, "{box: {min: [0, 0], max: [1, 0.5]}}", 0.1);
+    const std::string grid = "grid: {cell_size: ";
+    text.replace(text.find(grid), grid.size(), std::string("grid: {transfer: ") + transfer + ", cell_size: ");
+    const LoadedScene s = LoadSceneFromString(text, "s.yaml");
+    EXPECT_EQ(s.state.particles.C.size(), std::string(transfer) == "apic" ? 200u : 0u) << transfer;
+  }
 }
 
 TEST(SceneBuilderTest, TractionsSumToTractionTimesLengthIn2D) {
