@@ -123,7 +123,8 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, const std::vector<
       }
 }
 
-// The projected value q-bar_p of the group's particles of one block, handed to apply(p, q-bar).
+// The projected value q-bar_p of the group's particles of one block, handed to apply(p, q-bar);
+// s.weighted holds the slot means q-bar_i (Project divides it by s.weight before the gather).
 // Node-based: q-bar_p = sum_i N_ip q-bar_i, q-bar_i = sum N m q / sum N m (4.29)-(4.32).
 // Cell-based: q-bar_p = q-bar_c = sum_c m q / sum_c m (4.25)-(4.28).
 template <int kDim, class K, bool kNode, class Apply>
@@ -146,7 +147,7 @@ void GatherBlock(const StepContext& ctx, const Particles& P, const std::vector<V
             if (w == 0) continue;  // a node of zero weight may have no mass at all
             const long g = PaddedToGrid(grid, blk, lb.x() + i, lb.y() + j, lb.z() + c);
             SURGE_ASSERT(g >= 0);
-            q_bar += w * (s.weighted[g] / s.weight[g]);
+            q_bar += w * s.weighted[g];  // q-bar_i, normalised once per node by Project
           }
     } else {
       Vec3i cell = Vec3i::Zero();
@@ -154,7 +155,7 @@ void GatherBlock(const StepContext& ctx, const Particles& P, const std::vector<V
       const Vec3i lc = cell - origin;
       const long g = PaddedToGrid(grid, blk, lc.x(), lc.y(), lc.z());
       SURGE_ASSERT(g >= 0);
-      q_bar = s.weighted[g] / s.weight[g];
+      q_bar = s.weighted[g];  // q-bar_c, normalised once per cell slot by Project
     }
     if (std::isfinite(q_bar)) apply(p, q_bar);  // a non-finite one is left to CheckState
   }
@@ -175,6 +176,10 @@ void Project(const StepContext& ctx, const Particles& P, const std::vector<Vec3>
       ScatterBlock<kDim, K, kNode>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s, value);
     });
   }
+  // The node (cell) means q-bar_i = sum N m q / sum N m (4.30), once per slot, in place: the gather
+  // then multiplies instead of dividing at every stencil node (bitwise the same values). An empty
+  // slot gives 0/0 = NaN, as the division at gather time did, and is never used with weight > 0.
+  ParallelFor(s.weighted.size(), 4096, [&](size_t g) { s.weighted[g] /= s.weight[g]; });
   ParallelFor(grid.block_count(), 1, [&](size_t blk) {
     GatherBlock<kDim, K, kNode>(ctx, P, x_n, begin, end, grid, blk, s, apply);
   });
