@@ -62,7 +62,7 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
   // Memory at the first step (scene/memory_estimate.h; the run refuses a scene whose estimate
   // exceeds the available memory before seeding it).
   const MemoryEstimate memory =
-      EstimateMemory(double(P.size()), double(grid.block_count()), m.field_count, P.layout);
+      EstimateMemory(double(P.size()), double(grid.block_count()), m.field_count, m.dim, P.layout);
   std::printf("scene      %s (%s)\n", m.name.c_str(), path.c_str());
   std::printf("dimension  %d-D%s, cell size %g m, %s, %s\n", m.dim,
               m.dim == 2 ? " plane strain" : "", m.dx, ShapeName(m.shape),
@@ -84,8 +84,8 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
     std::printf("structures %zu obstacles (%zu prescribed, %zu dynamic), %zu sensors; force log: %s\n",
                 m.obstacles.size(), prescribed, dynamic, m.sensors.size(), names.c_str());
   }
-  std::printf("grid       %zu active blocks (8^3 nodes), %zu nodes with mass\n",
-              grid.block_count(), grid.ActiveNodeCount());
+  std::printf("grid       %zu active blocks (%s nodes), %zu nodes with mass\n",
+              grid.block_count(), m.dim == 3 ? "8^3" : "8^2", grid.ActiveNodeCount());
   std::printf("time step  %.4g s (CFL %.2f) -> about %.0f steps to t = %g s\n", dt, m.time.cfl,
               steps, m.time.end);
   const Real dt_viscous = ViscousTimeStep(m, scene.state);
@@ -99,7 +99,7 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
               "%s available\n",
               FormatBytes(memory.total()).c_str(), FormatBytes(memory.particle_bytes).c_str(),
               BytesPerParticle(P.layout), FormatBytes(memory.grid_bytes).c_str(),
-              BytesPerBlock(m.field_count), FormatBytes(AvailableMemory()).c_str());
+              BytesPerBlock(m.field_count, m.dim), FormatBytes(AvailableMemory()).c_str());
   for (const std::string& w : SceneWarnings(scene)) std::printf("warning    %s\n", w.c_str());
   std::printf("scene OK\n");
   return kExitOk;

@@ -67,9 +67,7 @@ inline void Constrain(const SurfaceQuery& q, const ObstacleContact& law, const V
 
 // World position of grid node i.
 inline Vec3 NodePosition(const SparseGrid& grid, size_t i, Real dx) {
-  const int l = int(i % kBlockNodes);
-  const Vec3i node = grid.block_origin[i / kBlockNodes] + Vec3i(l / 64, (l / 8) % 8, l % 8);
-  return node.cast<Real>() * dx;
+  return grid.NodeCoord(i).cast<Real>() * dx;
 }
 
 // Index of grid node `node` (node coordinates), which a particle binned in block `owner` reaches:
@@ -88,7 +86,7 @@ inline int64_t NodeFromOwner(const SparseGrid& grid, size_t owner, const Vec3i& 
   *block = blk;
   const Vec3i l = local - Vec3i((k & 1) ? kBlockDim : 0, (k & 2) ? kBlockDim : 0,
                                 (k & 4) ? kBlockDim : 0);
-  return int64_t(blk) * kBlockNodes + LocalNode(l.x(), l.y(), l.z());
+  return int64_t(blk) * grid.block_nodes + grid.Local(l.x(), l.y(), l.z());
 }
 
 // Broad phase: the blocks (in block order) whose node box meets [lo, hi] widened by tol.
@@ -240,10 +238,11 @@ void ObstacleGaps(const Model& model, const StepContext& ctx, const Obstacle& ob
                   const ObstaclePose& pose, const SparseGrid& grid, const Particles& P,
                   ContactScratch& scratch) {
   const size_t nb = grid.block_count();
-  scratch.gap.resize(nb * kBlockNodes);
+  scratch.gap.resize(nb * size_t(grid.block_nodes));
   scratch.candidate.assign(nb, 0);
   for (const int32_t b : scratch.blocks) {
-    std::fill_n(scratch.gap.begin() + ptrdiff_t(size_t(b) * kBlockNodes), kBlockNodes, kInf);
+    std::fill_n(scratch.gap.begin() + ptrdiff_t(size_t(b) * size_t(grid.block_nodes)),
+                grid.block_nodes, kInf);
     scratch.candidate[size_t(b)] = 1;
   }
   // Stencil of a particle along one axis: first node and width (shape_functions.h).
@@ -330,11 +329,11 @@ void ApplyObstacleContact(const Model& model, const StepContext& ctx,
       bool near = false;
       std::vector<ColumnNode>& columns = scratch.column_nodes[c];
       columns.clear();
-      for (int l = 0; l < kBlockNodes; ++l) {
-        const size_t i = b * kBlockNodes + l;
+      for (int l = 0; l < grid.block_nodes; ++l) {
+        const size_t i = b * size_t(grid.block_nodes) + size_t(l);
         const Real m = grid.mass[i];
         if (m <= 0) continue;
-        const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
+        const Vec3i node = grid.block_origin[b] + grid.LocalCoord(l);
         const Vec3 x = node.cast<Real>() * ctx.dx;
         SurfaceQuery q = QueryObstacle(ob, pose, x, model.dim, tol, 2 * ctx.dx);
         near |= q.distance < 2 * ctx.dx;
@@ -538,12 +537,12 @@ void SumSensors(const Model& model, const StepContext& ctx, const SparseGrid& gr
       const size_t b = size_t(scratch.blocks[c]);
       Real* part = &scratch.partial[c * stride];
       part[kMaxElev] = -kInf;
-      for (int l = 0; l < kBlockNodes; ++l) {
-        const size_t i = b * kBlockNodes + l;
+      for (int l = 0; l < grid.block_nodes; ++l) {
+        const size_t i = b * size_t(grid.block_nodes) + size_t(l);
         if (grid.mass[i] <= 0) continue;
         const Vec3& f = grid.reaction[i];
         if (f.isZero(0)) continue;
-        const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
+        const Vec3i node = grid.block_origin[b] + grid.LocalCoord(l);
         const Vec3 x = node.cast<Real>() * ctx.dx;
         bool inside = true;
         for (int a = 0; a < model.dim; ++a)

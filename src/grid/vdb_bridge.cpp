@@ -79,7 +79,7 @@ void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid) 
     const int c = (bc.x() & 1) | ((bc.y() & 1) << 1) | ((bc.z() & 1) << 2);
     grid.colour[c].push_back(static_cast<int32_t>(b));
   }
-  const size_t nodes = count * kBlockNodes;
+  const size_t nodes = count * size_t(grid.block_nodes);
   grid.mass.assign(nodes, 0.0);
   grid.momentum.assign(nodes, Vec3::Zero());
   grid.force.assign(nodes, Vec3::Zero());
@@ -114,8 +114,8 @@ void ExportGridVdb(const SparseGrid& grid, Real dx, const std::string& path) {
   for (size_t b = 0; b < grid.block_count(); ++b) {
     for (int lx = 0; lx < kBlockDim; ++lx)
       for (int ly = 0; ly < kBlockDim; ++ly)
-        for (int lz = 0; lz < kBlockDim; ++lz) {
-          const size_t i = b * kBlockNodes + LocalNode(lx, ly, lz);
+        for (int lz = 0; lz < grid.block_dz; ++lz) {
+          const size_t i = b * size_t(grid.block_nodes) + size_t(grid.Local(lx, ly, lz));
           if (grid.mass[i] <= 0) continue;
           const Vec3i n = grid.block_origin[b] + Vec3i(lx, ly, lz);
           const openvdb::Coord c(n.x(), n.y(), n.z());

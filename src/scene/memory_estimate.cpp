@@ -62,7 +62,7 @@ double BytesPerParticle(const ParticleLayout& layout) {
   return b;
 }
 
-double BytesPerBlock(int fields) {
+double BytesPerBlock(int fields, int dim) {
   using G = SparseGrid;
   const double node = Elem<decltype(G::mass)>() + Elem<decltype(G::momentum)>() +
                       Elem<decltype(G::force)>() + Elem<decltype(G::velocity)>() +
@@ -72,16 +72,17 @@ double BytesPerBlock(int fields) {
                        Elem<decltype(G::field_velocity)>() + Elem<decltype(G::field_velocity_new)>();
   const double topology = Elem<decltype(G::block_origin)>() + Elem<decltype(G::neighbor)>() +
                           Elem<decltype(G::wall_partials)>();
-  return kBlockNodes * (node + fields * field) + topology;
+  const double nodes = kBlockDim * kBlockDim * (dim == 3 ? kBlockDim : 1);  // SparseGrid::SetDimension
+  return nodes * (node + fields * field) + topology;
 }
 
-MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields,
+MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields, int dim,
                               const ParticleLayout& layout) {
   MemoryEstimate m;
   m.particles = particles;
   m.grid_blocks = grid_blocks;
   m.particle_bytes = particles * BytesPerParticle(layout);
-  m.grid_bytes = grid_blocks * BytesPerBlock(fields);
+  m.grid_bytes = grid_blocks * BytesPerBlock(fields, dim);
   return m;
 }
 

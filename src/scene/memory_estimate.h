@@ -12,7 +12,7 @@ namespace surge {
 
 struct MemoryEstimate {
   double particles = 0;        // particle count
-  double grid_blocks = 0;      // active blocks of 8^3 nodes
+  double grid_blocks = 0;      // active blocks of 8^3 nodes (8^2 in 2-D)
   double particle_bytes = 0;   // Particles SoA + per-particle scratch (workspace, grid binning, writer)
   double grid_bytes = 0;       // node fields of the blocks (with the per-body fields of body_contact)
   double total() const { return particle_bytes + grid_bytes; }
@@ -22,11 +22,11 @@ struct MemoryEstimate {
 // the snapshot scratch of the results writer), for the optional arrays of `layout`.
 double BytesPerParticle(const ParticleLayout& layout);
 // Bytes of node fields per active block with `fields` per-body velocity fields (0 without
-// body_contact).
-double BytesPerBlock(int fields);
+// body_contact): 8^3 nodes in 3-D, 8^2 in 2-D.
+double BytesPerBlock(int fields, int dim);
 
 // Pre: particles, grid_blocks >= 0.
-MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields,
+MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields, int dim,
                               const ParticleLayout& layout);
 
 // Blocks of 8^3 nodes covering the box [lo, hi] [m] at cell size dx [m], one block more on each

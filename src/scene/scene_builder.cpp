@@ -57,14 +57,14 @@ void CheckMemory(const SceneSpec& spec, double particles, Aabb box, int fields,
   box.max = box.max.cwiseMin(spec.domain.max);
   const MemoryEstimate m = EstimateMemory(
       particles, BlocksCovering(box.min, box.max, spec.grid.cell_size, spec.dimension), fields,
-      layout);
+      spec.dimension, layout);
   const double available = AvailableMemory();
   if (m.total() <= available) return;
   const SourceLoc& loc = spec.bodies.empty() ? SourceLoc{} : spec.bodies.front().loc;
   Fail(loc, "bodies",
        "the run needs about " + FormatBytes(m.total()) + " of memory (" + qualifier +
            Num(std::round(particles)) + " particles x " + Num(BytesPerParticle(layout)) + " bytes + " +
-           Num(m.grid_blocks) + " grid blocks x " + Num(BytesPerBlock(fields)) +
+           Num(m.grid_blocks) + " grid blocks x " + Num(BytesPerBlock(fields, spec.dimension)) +
            " bytes), more than the " + FormatBytes(available) +
            " available on this machine; use a larger grid.cell_size or fewer particles_per_cell");
 }

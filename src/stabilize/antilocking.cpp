@@ -167,8 +167,8 @@ template <int kDim, class K, bool kNode, class Value, class Apply>
 void Project(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
              size_t begin, size_t end, const SparseGrid& grid, AntiLockingScratch& s,
              const Value& value, const Apply& apply) {
-  s.weight.assign(grid.block_count() * kBlockNodes, 0.0);
-  s.weighted.assign(grid.block_count() * kBlockNodes, 0.0);
+  s.weight.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
+  s.weighted.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
     ParallelFor(blocks.size(), 1, [&](size_t i) {
@@ -473,7 +473,7 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
   // every scatter.
   const bool node = al.method == AntiLockingMethod::kNode;
   const bool constant_trace = al.approach == AntiLockingApproach::kConstantVolumetric;
-  s.moments.assign(grid.block_count() * kBlockNodes * size_t(M), 0.0);
+  s.moments.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(M), 0.0);
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
     ParallelFor(blocks.size(), 1, [&](size_t i) {
@@ -490,10 +490,10 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
     // node itself (xi = 0 in node-centred coordinates); AS3CV takes the trace's weighted mean.
     // Then eps^h_p = M* sum_i N_ip eps-hat_i (4.32)_1.
     constexpr int Q = F::kLinear + F::kConst;
-    s.node_fit.assign(grid.block_count() * kBlockNodes * size_t(Q), 0.0);
+    s.node_fit.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(Q), 0.0);
     ParallelFor(grid.block_count(), 1, [&](size_t blk) {
-      for (int l = 0; l < kBlockNodes; ++l) {
-        const size_t g = blk * kBlockNodes + size_t(l);
+      for (int l = 0; l < grid.block_nodes; ++l) {
+        const size_t g = blk * size_t(grid.block_nodes) + size_t(l);
         const Real* a = &s.moments[g * M];
         if (a[0] == 0) continue;
         // A node's fit is evaluated at the node, which can lie outside its particles (a free
@@ -572,7 +572,7 @@ template <int kDim, class K>
 void SmoothVolumetricStrain(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
                             size_t begin, size_t end, const SparseGrid& grid, const Mode& mode,
                             AntiLockingScratch& s, std::vector<Mat3>& L) {
-  const size_t slots = grid.block_count() * kBlockNodes;
+  const size_t slots = grid.block_count() * size_t(grid.block_nodes);
   s.weight.assign(slots, 0.0);
   s.weighted.assign(slots, 0.0);
   const auto theta = [&](size_t p) {
@@ -594,11 +594,12 @@ void SmoothVolumetricStrain(const StepContext& ctx, const Particles& P, const st
     const auto& blocks = grid.colour[colour];
     ParallelFor(blocks.size(), 1, [&](size_t i) {
       const size_t blk = size_t(blocks[i]);
-      for (int l = 0; l < kBlockNodes; ++l) {
-        const size_t g = blk * kBlockNodes + size_t(l);
+      for (int l = 0; l < grid.block_nodes; ++l) {
+        const size_t g = blk * size_t(grid.block_nodes) + size_t(l);
         if (s.weight[g] == 0) continue;  // an empty cell
         const Real theta_c = s.weighted[g] / s.weight[g];
-        const int lx = l / (kBlockDim * kBlockDim), ly = (l / kBlockDim) % kBlockDim, lz = l % kBlockDim;
+        const Vec3i lc = grid.LocalCoord(l);
+        const int lx = lc.x(), ly = lc.y(), lz = lc.z();
         for (int a = 0; a < 2; ++a)
           for (int b = 0; b < 2; ++b)
             for (int c = 0; c < kz; ++c) {

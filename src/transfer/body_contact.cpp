@@ -88,8 +88,8 @@ void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& gr
   const Vec3 up = g_norm > 0 ? Vec3(-model.gravity / g_norm) : Vec3::UnitY();
   ParallelFor(nb, 4, [&](size_t b) {
     Real* part = &partial[b * K];
-    for (int l = 0; l < kBlockNodes; ++l) {
-      const size_t i = b * kBlockNodes + l;
+    for (int l = 0; l < grid.block_nodes; ++l) {
+      const size_t i = b * size_t(grid.block_nodes) + size_t(l);
       const Real m = grid.mass[i];
       if (m <= 0) continue;
       int present = 0;
@@ -108,7 +108,7 @@ void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& gr
       // its constraints (walls, obstacles) made.
       const Vec3 vu = grid.velocity[i] + ctx.dt * (grid.force[i] / m + ctx.gravity);
       const Vec3 constraint = vc - vu;
-      const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
+      const Vec3i node = grid.block_origin[b] + grid.LocalCoord(l);
       const Vec3 x = node.cast<Real>() * ctx.dx;
       for (int f = 0; f < F; ++f) {
         const size_t fi = f * N + i;

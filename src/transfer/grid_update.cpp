@@ -98,8 +98,8 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
   ParallelFor(nb, 4, [&](size_t b) {
     auto& part = partial[b];
     part[kMaxElevation] = -std::numeric_limits<Real>::infinity();
-    for (int l = 0; l < kBlockNodes; ++l) {
-      const size_t i = b * kBlockNodes + l;
+    for (int l = 0; l < grid.block_nodes; ++l) {
+      const size_t i = b * size_t(grid.block_nodes) + size_t(l);
       const Real m = grid.mass[i];
       if (m <= 0) {
         grid.velocity[i].setZero();
@@ -112,7 +112,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
       grid.velocity[i] = v;
       Vec3 vc = vu;
       if (wall_count > 0) {
-        const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
+        const Vec3i node = grid.block_origin[b] + grid.LocalCoord(l);
         const Vec3 x = node.cast<Real>() * ctx.dx;
         Vec3 dv[kFaceCount];
         if (ApplyWalls(walls, wall_count, x, tolerance, vc, dv, &grid, node)) {
@@ -160,10 +160,7 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
   WallPlane walls[kFaceCount];
   const int wall_count = ActiveWalls(model, walls);
   const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, as in UpdateGridVelocity
-  auto node_coord = [&](size_t i) {  // node index of grid node i
-    const int l = int(i % kBlockNodes);
-    return Vec3i(grid.block_origin[i / kBlockNodes] + Vec3i(l / 64, (l / 8) % 8, l % 8));
-  };
+  auto node_coord = [&](size_t i) { return grid.NodeCoord(i); };  // node index of grid node i
   if (collect) {
     grid.ghosts.clear();
     for (size_t b = 0; b < grid.block_count(); ++b) {
@@ -176,8 +173,8 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
         // Mirror image of node index n across the plane: 2 level / dx - n (exact for a wall on
         // a node or half-way between two; else the nearest node, docs/walls.md).
         const int twice = int(std::lround(2 * w.level * ctx.inv_dx));
-        for (int l = 0; l < kBlockNodes; ++l) {
-          const size_t i = b * kBlockNodes + l;
+        for (int l = 0; l < grid.block_nodes; ++l) {
+          const size_t i = b * size_t(grid.block_nodes) + size_t(l);
           if (!(grid.mass[i] > 0)) continue;
           const Vec3i n = node_coord(i);
           if (w.sign * (n[a] * ctx.dx - w.level) >= -tolerance) continue;  // on or inside
@@ -208,7 +205,7 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
     const int32_t b = grid.ghost_mirror_index[k];
     if (b < 0) return -1;
     const Vec3i local = c - grid.ghost_mirror_block[k] * kBlockDim;
-    const size_t j = size_t(b) * kBlockNodes + LocalNode(local.x(), local.y(), local.z());
+    const size_t j = size_t(b) * size_t(grid.block_nodes) + size_t(grid.Local(local.x(), local.y(), local.z()));
     return grid.mass[j] > 0 ? int64_t(j) : -1;
   };
   const bool keep_reaction = report && !model.sensors.empty();
@@ -313,8 +310,8 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
 void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid) {
   const Real alpha = ctx.damping;
   ParallelFor(grid.block_count(), 4, [&](size_t b) {
-    for (int l = 0; l < kBlockNodes; ++l) {
-      const size_t i = b * kBlockNodes + l;
+    for (int l = 0; l < grid.block_nodes; ++l) {
+      const size_t i = b * size_t(grid.block_nodes) + size_t(l);
       const Real m = grid.mass[i];
       if (m <= 0) continue;
       const Vec3& v = grid.velocity[i];
@@ -335,15 +332,15 @@ void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGri
   const int wall_count = ActiveWalls(model, walls);
   const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, robust to round-off of i*dx
   ParallelFor(grid.block_count(), 4, [&](size_t b) {
-    for (int l = 0; l < kBlockNodes; ++l) {
-      const size_t i = b * kBlockNodes + l;
+    for (int l = 0; l < grid.block_nodes; ++l) {
+      const size_t i = b * size_t(grid.block_nodes) + size_t(l);
       const Real m = grid.mass[i];
       if (m <= 0) continue;
       // The re-mapped momentum is sum N m_p v_p; with mass scaling the nodal mass is beta m_i
       // (ParticleToGridStage), so the velocity takes the same factor.
       Vec3 v = ctx.mass_scale * grid.momentum[i] / m;
       if (wall_count > 0) {
-        const Vec3i node = grid.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8);
+        const Vec3i node = grid.block_origin[b] + grid.LocalCoord(l);
         Vec3 dv[kFaceCount];
         ApplyWalls(walls, wall_count, node.cast<Real>() * ctx.dx, tolerance, v, dv, &grid, node);
       }

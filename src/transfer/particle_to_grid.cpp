@@ -245,7 +245,7 @@ void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles&
     return;
   }
   // Per-body velocity fields, only where a scene has body contacts. The sums are zeroed each
-  // step, in 2-D only on the z = 0 plane of each block (the only nodes a 2-D run touches). The
+  // step (a 2-D block holds only its z = 0 plane, SparseGrid::SetDimension). The
   // velocities are only written where a field has mass and read, with weight zero, elsewhere:
   // they need to be finite, not zero (new entries start at zero).
   const size_t nodes = grid.mass.size(), n = size_t(model.field_count) * nodes;
@@ -256,11 +256,10 @@ void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles&
   grid.field_mass_moment.resize(n);
   grid.field_velocity.resize(n, Vec3::Zero());
   grid.field_velocity_new.resize(n, Vec3::Zero());
-  const int stride = model.dim == 2 ? kBlockDim : 1;  // lz = 0 only in 2-D
   ParallelFor(grid.block_count() * size_t(model.field_count), 4, [&](size_t k) {
     const size_t f = k / grid.block_count(), b = k % grid.block_count();
-    for (int l = 0; l < kBlockNodes; l += stride) {
-      const size_t i = f * nodes + b * kBlockNodes + size_t(l);
+    for (int l = 0; l < grid.block_nodes; ++l) {
+      const size_t i = f * nodes + b * size_t(grid.block_nodes) + size_t(l);
       grid.field_mass[i] = 0;
       grid.field_momentum[i].setZero();
       grid.field_force[i].setZero();

@@ -17,13 +17,14 @@ struct BlockPad {
   static constexpr int Index(int a, int b, int c) { return (a * E + b) * Ez + c; }
 };
 
-// Grid index (block*512 + local) of padded node (a,b,c) of block `block`, or -1 when the
+// Grid index (block * block_nodes + local) of padded node (a,b,c) of block `block`, or -1 when the
 // neighbour block that holds it is not active.
 inline long PaddedToGrid(const SparseGrid& grid, size_t block, int a, int b, int c) {
   const int o = (a >= kBlockDim) | ((b >= kBlockDim) << 1) | ((c >= kBlockDim) << 2);
   const int32_t nb = grid.neighbor[block][o];
   if (nb < 0) return -1;
-  return long(nb) * kBlockNodes + LocalNode(a & (kBlockDim - 1), b & (kBlockDim - 1), c & (kBlockDim - 1));
+  return long(nb) * grid.block_nodes +
+         grid.Local(a & (kBlockDim - 1), b & (kBlockDim - 1), c & (kBlockDim - 1));
 }
 
 // GIMP half-width of a particle (cell units); 0 for the other kernels.

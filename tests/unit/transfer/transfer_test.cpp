@@ -19,11 +19,11 @@ struct Totals {
 Totals GridTotals(const SparseGrid& g, Real dx) {
   Totals t;
   for (size_t b = 0; b < g.block_count(); ++b)
-    for (int l = 0; l < kBlockNodes; ++l) {
-      const size_t i = b * kBlockNodes + l;
+    for (int l = 0; l < g.block_nodes; ++l) {
+      const size_t i = b * size_t(g.block_nodes) + size_t(l);
       t.mass += g.mass[i];
       t.momentum += g.momentum[i];
-      const Vec3 x = (g.block_origin[b] + Vec3i(l / 64, (l / 8) % 8, l % 8)).cast<Real>() * dx;
+      const Vec3 x = g.NodeCoord(i).cast<Real>() * dx;
       t.angular += x.cross(g.momentum[i]);
     }
   return t;
