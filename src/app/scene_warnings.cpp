@@ -148,7 +148,7 @@ std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
     for (size_t b = 0; b < m.bodies.size(); ++b) {
       bool prestressed = false;
       for (size_t p = 0; p < P.size() && !prestressed; ++p)
-        prestressed = P.body[p] == int(b) && !P.stress[p].isZero(0);
+        prestressed = P.body[p] == int(b) && !P.stress[p].isZero();
       if (prestressed)
         out.push_back(fmt::format(
             "bodies[{}] '{}': starts with a geostatic stress while gravity_ramp = {:.3g} s; the "

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products
 #include <Eigen/LU>        // 3x3 determinants
+#include <cmath>
 #include <cstdint>
 
 namespace surge {
@@ -19,5 +20,51 @@ inline Mat3 Sym(const Mat3& a) { return 0.5 * (a + a.transpose()); }
 
 // Deviatoric part of a 3x3 matrix.
 inline Mat3 Dev(const Mat3& a) { return a - (a.trace() / 3.0) * Mat3::Identity(); }
+
+// A symmetric 3x3 tensor stored as its 6 independent components, Voigt order xx yy zz xy yz xz:
+// the particle stress (48 instead of 72 bytes per particle; performance issue). Built from a
+// matrix, it keeps the mean of each off-diagonal pair, which is the entry itself, bitwise, for a
+// symmetric matrix (a + a is exact and so is the halving).
+struct SymMat3 {
+  Real v[6] = {0, 0, 0, 0, 0, 0};
+
+  SymMat3() = default;
+  template <class Derived>
+  SymMat3(const Eigen::MatrixBase<Derived>& m)  // NOLINT(google-explicit-constructor): a value
+      : v{m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(0, 1) + m(1, 0)), 0.5 * (m(1, 2) + m(2, 1)),
+          0.5 * (m(0, 2) + m(2, 0))} {}
+
+  Mat3 matrix() const {
+    Mat3 m;
+    m << v[0], v[3], v[5],  //
+        v[3], v[1], v[4],   //
+        v[5], v[4], v[2];
+    return m;
+  }
+  operator Mat3() const { return matrix(); }  // NOLINT(google-explicit-constructor)
+  // Component (i, j), i, j in 0..2.
+  Real operator()(int i, int j) const {
+    if (i == j) return v[i];
+    const int k = i + j;  // 1: xy, 3: yz, 2: xz
+    return v[k == 1 ? 3 : k == 3 ? 4 : 5];
+  }
+  Real trace() const { return v[0] + v[1] + v[2]; }
+  bool allFinite() const {
+    for (Real x : v)
+      if (!std::isfinite(x)) return false;
+    return true;
+  }
+  bool isZero() const {
+    for (Real x : v)
+      if (x != 0) return false;
+    return true;
+  }
+  bool operator==(const SymMat3& o) const {
+    for (int k = 0; k < 6; ++k)
+      if (v[k] != o.v[k]) return false;
+    return true;
+  }
+};
+static_assert(sizeof(SymMat3) == 6 * sizeof(Real), "SymMat3 must be packed");
 
 }  // namespace surge

@@ -42,7 +42,7 @@ struct Particles {
   std::vector<Mat3> C;       // APIC affine velocity [1/s]        written by GridToParticle (APIC)
                              //   (optional: layout.affine)
   std::vector<Mat3> F;       // deformation gradient [-]          written by UpdateDeformation
-  std::vector<Mat3> stress;  // Cauchy stress [Pa]                written by UpdateStress
+  std::vector<SymMat3> stress;  // Cauchy stress [Pa], 6 components  written by UpdateStress
   std::vector<Mat3> strain;  // accumulated small strain [-]      written by UpdateStress
                              //   (optional: layout.strain, linear_elastic only)
   // Material history (optional: layout.elastic_b / layout.history, plastic models only).

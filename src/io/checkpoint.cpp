@@ -34,6 +34,7 @@ constexpr int kFormatVersion = 2;
 static_assert(sizeof(Vec3) == 3 * sizeof(double) && sizeof(Mat3) == 9 * sizeof(double),
               "Eigen fixed-size types must be packed");
 static_assert(sizeof(History) == kHistorySlots * sizeof(double), "History must be packed");
+static_assert(sizeof(SymMat3) == 6 * sizeof(double), "SymMat3 must be packed");
 static_assert(std::is_same_v<Real, double>, "checkpoints store Real as float64");
 // Particles has exactly the 14 arrays written and read below: a new array must be added here
 // (and to docs/results-format.md, "Checkpoints") or restarts silently lose it.
@@ -322,6 +323,16 @@ size_t Rows(hid_t loc, const char* name, const std::string& path) {
   return size_t(dims[0]);
 }
 
+// The number of columns of a rank-2 dataset (0 for any other rank).
+size_t Cols(hid_t loc, const char* name, const std::string& path) {
+  Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
+  Require(ds.ok(), std::string("open ") + name, path);
+  Handle space(H5Dget_space(ds.get()), H5Sclose);
+  hsize_t dims[H5S_MAX_RANK] = {};
+  const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  return rank == 2 ? size_t(dims[1]) : 0;
+}
+
 }  // namespace
 
 std::string SceneHash(const std::string& text) { return Fnv1aHex(text); }
@@ -397,7 +408,7 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
       WriteDoubles(l, "v", P.v.data(), n, 3, tmp);
       if (P.layout.affine) WriteDoubles(l, "C", P.C.data(), n, 9, tmp);
       WriteDoubles(l, "F", P.F.data(), n, 9, tmp);
-      WriteDoubles(l, "stress", P.stress.data(), n, 9, tmp);
+      WriteDoubles(l, "stress", P.stress.data(), n, 6, tmp);  // xx yy zz xy yz xz
       if (P.layout.strain) WriteDoubles(l, "strain", P.strain.data(), n, 9, tmp);
       if (P.layout.elastic_b) WriteDoubles(l, "elastic_b", P.elastic_b.data(), n, 9, tmp);
       if (P.layout.history) WriteDoubles(l, "history", P.history.data(), n, kHistorySlots, tmp);
@@ -518,7 +529,13 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
     P.layout.affine = H5Lexists(l, "C", H5P_DEFAULT) > 0;
     if (P.layout.affine) ReadArray(l, "C", d, n, 9, P.C, path);
     ReadArray(l, "F", d, n, 9, P.F, path);
-    ReadArray(l, "stress", d, n, 9, P.stress, path);
+    if (Cols(l, "stress", path) == 9) {  // written before 2026-12-03: the full matrix
+      std::vector<Mat3> full;
+      ReadArray(l, "stress", d, n, 9, full, path);
+      P.stress.assign(full.begin(), full.end());
+    } else {
+      ReadArray(l, "stress", d, n, 6, P.stress, path);
+    }
     P.layout.strain = H5Lexists(l, "strain", H5P_DEFAULT) > 0;
     if (P.layout.strain) ReadArray(l, "strain", d, n, 9, P.strain, path);
     P.layout.elastic_b = H5Lexists(l, "elastic_b", H5P_DEFAULT) > 0;

@@ -854,16 +854,14 @@ void ResultsWriter::WriteSnapshot(const State& state) {
     write_doubles("position", n ? P.x[0].data() : nullptr, 3);
     write_doubles("velocity", n ? P.v[0].data() : nullptr, 3);
     write_derived("stress", 6, [&](size_t p, double* out) {
-      const Mat3& s = P.stress[p];
-      // VTK/ParaView order xx yy zz xy yz xz, so ParaView's component labels are right.
-      const double voigt[6] = {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2)};
-      std::copy(voigt, voigt + 6, out);
+      // VTK/ParaView order xx yy zz xy yz xz (SymMat3's own), so ParaView's labels are right.
+      std::copy(P.stress[p].v, P.stress[p].v + 6, out);
     });
     write_derived("pressure", 0, [&](size_t p, double* out) {
       *out = -P.stress[p].trace() / 3.0;  // > 0 in compression
     });
     write_derived("von_mises", 0, [&](size_t p, double* out) {
-      *out = std::sqrt(1.5 * Dev(P.stress[p]).squaredNorm());  // q = sqrt(3/2 s:s)
+      *out = std::sqrt(1.5 * Dev(P.stress[p].matrix()).squaredNorm());  // q = sqrt(3/2 s:s)
     });
     {  // both strain invariants from one eigen-solve per particle: two halves of the scratch
       I.scratch.resize(2 * n);

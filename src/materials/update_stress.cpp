@@ -42,8 +42,10 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
-                       LinearElasticUpdate(params, Sym(f - Mat3::Identity()), P.stress[p],
+                       Mat3 stress = P.stress[p];
+                       LinearElasticUpdate(params, Sym(f - Mat3::Identity()), stress,
                                            P.strain[p]);
+                       P.stress[p] = stress;
                      });
                    },
                    [&](const NeoHookeanParams& params) {
@@ -61,8 +63,10 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
+                       Mat3 stress;
                        PlasticUpdate(params, f, P.F[p].determinant(), P.elastic_b[p],
-                                     P.history[p], P.stress[p]);
+                                     P.history[p], stress);
+                       P.stress[p] = stress;
                      });
                    },
                    [&](const NewtonianFluidParams& params) {
@@ -79,8 +83,10 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
+                       Mat3 stress;
                        BinghamFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p], dt,
-                                          P.history[p], P.stress[p]);  // A3D (7.37)
+                                          P.history[p], stress);  // A3D (7.37)
+                       P.stress[p] = stress;
                      });
                    },
                    [&](const FrictionalFluidParams& params) {
@@ -88,8 +94,10 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
+                       Mat3 stress;
                        FrictionalFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p],
-                                             dt, P.history[p], P.stress[p]);  // A3D (7.38)
+                                             dt, P.history[p], stress);  // A3D (7.38)
+                       P.stress[p] = stress;
                      });
                    },
                },

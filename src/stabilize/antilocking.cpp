@@ -715,7 +715,8 @@ void ProjectMeanStress(const Model& model, const StepContext& ctx,
       // the deviator kept (4.28), (4.32)_2.
       const auto replace = [&](size_t p, Real q_bar) {
         const Real mean = q_bar * P.mass[p] / (P.volume0[p] * P.F[p].determinant());
-        P.stress[p].diagonal().array() += mean - P.stress[p].trace() / 3.0;
+        const Real shift = mean - P.stress[p].trace() / 3.0;
+        for (int d = 0; d < 3; ++d) P.stress[p].v[d] += shift;
       };
       Project<kDim, K, kNode>(ctx, P, x_n, g.begin, g.end, grid, scratch, mean_specific, replace);
     });

@@ -67,7 +67,7 @@ void ApplyBulkViscosity(Particles& P, BulkViscosityScratch& scratch) {
   ParallelFor(n, 1024, [&](size_t p) {
     if (scratch.q[p] == 0) return;
     scratch.saved[p] = P.stress[p];
-    P.stress[p].diagonal().array() -= scratch.q[p];  // sigma - q 1 (tension positive)
+    for (int d = 0; d < 3; ++d) P.stress[p].v[d] -= scratch.q[p];  // sigma - q 1 (tension positive)
   });
 }
 

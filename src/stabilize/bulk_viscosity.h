@@ -26,7 +26,7 @@ struct BulkViscosityScratch {
   std::vector<int64_t> id;    // Particles::id of each q entry (the particles may be reordered or
                               // removed before the next step uses q)
   std::vector<Real> by_id;    // scratch of the re-alignment, indexed by id [Pa]
-  std::vector<Mat3> saved;    // the material stress during ParticleToGrid [Pa]
+  std::vector<SymMat3> saved;  // the material stress during ParticleToGrid [Pa]
   // Time-step bound of the viscous materials from the last step (LS-DYNA Theory Manual, time
   // step with bulk viscosity): dt <= l / (Q + sqrt(Q^2 + c^2) + |v|), Q = c1 c + c0 l |tr d|
   // (tr d < 0; Q = c1 c otherwise), before the Courant number. Infinity before the first step.

@@ -120,7 +120,7 @@ static Real StressPower(const Particles& P, const std::vector<Mat3>& L) {
   ParallelChunks(P.size(), [&](size_t c, size_t b, size_t e) {
     Real sum = 0;
     for (size_t p = b; p < e; ++p)
-      sum += P.F[p].determinant() * P.volume0[p] * P.stress[p].cwiseProduct(Sym(L[p])).sum();
+      sum += P.F[p].determinant() * P.volume0[p] * P.stress[p].matrix().cwiseProduct(Sym(L[p])).sum();
     partial[c] = sum;
   });
   Real total = 0;

@@ -42,8 +42,8 @@ TEST(HealthCheckTest, HealthyStatePasses) {
 
 TEST(HealthCheckTest, StressOnlyNamesUpdateStress) {
   Fixture f;
-  f.s.particles.stress[700](0, 1) = kNaN;
-  f.s.particles.stress[300](1, 1) = std::numeric_limits<Real>::infinity();
+  f.s.particles.stress[700].v[3] = kNaN;  // xy
+  f.s.particles.stress[300].v[1] = std::numeric_limits<Real>::infinity();  // yy
   const Health h = Check(f.m, f.s, 0.4 * f.dt_limit);
   EXPECT_EQ(h.status, HealthStatus::kNonFinite);
   EXPECT_EQ(h.stage, "update_stress");
@@ -58,7 +58,7 @@ TEST(HealthCheckTest, StressOnlyNamesUpdateStress) {
 // A bad velocity precedes a bad stress in the step: it is reported even at a higher index.
 TEST(HealthCheckTest, EarliestFieldWinsOverLowerIndex) {
   Fixture f;
-  f.s.particles.stress[10](0, 0) = kNaN;
+  f.s.particles.stress[10].v[0] = kNaN;  // xx
   f.s.particles.F[500](0, 0) = -1;  // det F = -1
   f.s.particles.v[900].x() = kNaN;
   const Health h = Check(f.m, f.s, 0.4 * f.dt_limit);
@@ -95,7 +95,7 @@ TEST(HealthCheckTest, FixedDtAboveTheLimitIsTheCause) {
 // The same offender on 1 and 2 threads (the chunks are fixed, the choice is by index).
 TEST(HealthCheckTest, OffenderIndependentOfThreadCount) {
   Fixture f;
-  for (size_t p : {999u, 640u, 321u}) f.s.particles.stress[p](2, 2) = kNaN;
+  for (size_t p : {999u, 640u, 321u}) f.s.particles.stress[p].v[2] = kNaN;  // zz
   std::string one, two;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);

@@ -372,7 +372,7 @@ FreeBlock RunFreeLinearApicBlock(int ppc, Real perturbation, Real spin, Real end
       r.health = report.health;
       break;
     }
-    for (const Mat3& sigma : P.stress)
+    for (const Mat3 sigma : P.stress)
       r.max_stress = std::max(r.max_stress, sigma.cwiseAbs().maxCoeff());
   }
   Real angular1, kinetic1;

@@ -41,7 +41,7 @@ inline State RandomState(int dim, size_t n, const Vec3& centre, Real size, Real 
     for (int i = 0; i < dim; ++i)
       for (int j = 0; j < dim; ++j) P.C[p](i, j) = u(rng);
     P.F[p].setIdentity();
-    P.stress[p].setZero();
+    P.stress[p] = SymMat3();
     P.strain[p].setZero();
     P.mass[p] = 0.5 + u(rng);
     P.volume0[p] = vol;

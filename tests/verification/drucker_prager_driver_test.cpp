@@ -38,7 +38,7 @@ DruckerPragerParams Soil(Real phi_deg, Real psi_deg, Real c, Real k = 0, Real H 
                              -DruckerPragerCohesionTerm(c, phi) / std::sqrt(2.0 / 3.0), k, H};
 }
 Material Mat(const DruckerPragerParams& p) { return Material{"soil", 2000.0, p}; }
-Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0]; }
+Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix(); }
 using testing::RandomL;
 
 TEST(DruckerPragerTest, ReturnsEndOnTheConeOrAtTheApex) {
@@ -103,8 +103,8 @@ TEST(DruckerPragerTest, ZeroFrictionIsJ2) {
       const Mat3 L = RandomL(rng, 400);
       StepMaterialPoint(a, L, 1e-6);
       StepMaterialPoint(b, L, 1e-6);
-      worst = std::max(worst, (a.particles.stress[0] - b.particles.stress[0]).norm() /
-                                  a.particles.stress[0].norm());
+      worst = std::max(worst, (a.particles.stress[0].matrix() - b.particles.stress[0].matrix()).norm() /
+                                  a.particles.stress[0].matrix().norm());
     }
     std::printf("DP with varrho = 0 vs J2 (k %g, H %g): max relative stress difference %.2e\n", k, H,
                 worst);
@@ -128,12 +128,12 @@ TEST(DruckerPragerTest, RigidRotationIsObjective) {
   ASSERT_GT(pt.particles.history[0][kJ2PlasticStrain], 0);
   std::uniform_real_distribution<Real> u(-1.0, 1.0);
   for (int r = 0; r < 10; ++r) {
-    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 sigma0 = pt.particles.stress[0].matrix();
     const Mat3 beta0 = J2BackStressOf(pt.particles.history[0]);
     const Mat3 R = Eigen::AngleAxis<Real>(3 * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized())
                        .toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / 1e-4, 1e-4);
-    EXPECT_LE((pt.particles.stress[0] - R * sigma0 * R.transpose()).norm(), 1e-10 * sigma0.norm());
+    EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(), 1e-10 * sigma0.norm());
     EXPECT_LE((J2BackStressOf(pt.particles.history[0]) - R * beta0 * R.transpose()).norm(),
               1e-10 * sigma0.norm());
   }
@@ -186,7 +186,7 @@ TEST(DruckerPragerTest, TriaxialCompressionAndApex) {
   }
   MaterialPoint sand = MakeMaterialPoint(Mat(Soil(30, 0, 0)), -50e3 * Mat3::Identity());
   StepMaterialPoint(sand, 1.0 * Mat3::Identity(), 1e-2);  // 1 % stretch per axis
-  EXPECT_EQ(sand.particles.stress[0].norm(), 0.0) << "cohesionless apex is stress-free";
+  EXPECT_EQ(sand.particles.stress[0].matrix().norm(), 0.0) << "cohesionless apex is stress-free";
 }
 
 // Scene of the block: the cohesion is spliced in; gravity ramps over 0.3 s (seed App. B.2.3).
@@ -229,7 +229,7 @@ TEST(DruckerPragerTest, SceneBlockStandsWithCohesionAndCollapsesWithout) {
       kinetic = 0;
       for (size_t i = 0; i < P.size(); ++i) {
         kinetic += 0.5 * P.mass[i] * P.v[i].squaredNorm();
-        const Mat3 tau = P.F[i].determinant() * P.stress[i];
+        const Mat3 tau = P.F[i].determinant() * P.stress[i].matrix();
         const Real scale = std::max(tau.norm(), 1e3);
         // Admissible: inside the cone (3.84) and below the cutoff (3.93).
         worst = std::max(worst, DruckerPragerYield(p, tau, P.history[i]) / scale);

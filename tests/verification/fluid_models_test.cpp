@@ -76,7 +76,7 @@ TEST(BinghamFluidTest, SteadySimpleShearFollowsTheBiviscousFlowCurve) {
   for (Real rate : {0.01, 0.1, 0.3, 0.4, 0.41, 1.0, 10.0, 100.0, 1000.0}) {
     MaterialPoint pt = MakeMaterialPoint(Material{"mud", 1800, p});
     for (int n = 0; n < 10; ++n) StepMaterialPoint(pt, SimpleShear(rate), 1e-3);
-    const Mat3& sigma = pt.particles.stress[0];
+    const Mat3& sigma = pt.particles.stress[0].matrix();
     const Real expected =
         rate > rate_c ? p.yield_stress + p.viscosity * rate : p.max_viscosity * rate;
     std::printf("  gamma_dot %8.3f 1/s: sigma_12 = %10.4f Pa (expected %10.4f), J - 1 = %.1e\n",
@@ -103,7 +103,7 @@ TEST(BinghamFluidTest, YieldedFlowStressLiesOnTheDynamicYieldSurface) {
     const Real scale = std::pow(10.0, -2.0 + 4.0 * (n % 100) / 100.0);  // 0.01 .. 100 1/s
     const Mat3 L = RandomL(rng, scale);
     StepMaterialPoint(pt, L, 1e-5);
-    const Mat3& sigma = pt.particles.stress[0];
+    const Mat3& sigma = pt.particles.stress[0].matrix();
     const Real rate = ShearRateNorm(Sym(L));
     const Real q = EquivalentShear(sigma);
     const Real sigma_m = FluidMeanStress(EquationOfStateOf(p), pt.particles.F[0].determinant());
@@ -137,7 +137,7 @@ TEST(FrictionalFluidTest, ShearUnderConfiningPressure) {
       StepMaterialPoint(sheared, SimpleShear(rate), 1e-4);  // isochoric: J unchanged
       const Real expected = cohesion * std::cos(p.friction_angle) +
                             pressure * std::sin(p.friction_angle) + p.viscosity * rate;
-      const Mat3& sigma = sheared.particles.stress[0];
+      const Mat3& sigma = sheared.particles.stress[0].matrix();
       std::printf("frictional fluid phi = 30 deg, c = %g Pa, p = %.2f Pa, gamma_dot = %g: "
                   "sigma_12 = %.6f Pa (c cos phi + p sin phi + mu_d gamma_dot = %.6f)\n",
                   cohesion, pressure, rate, sigma(0, 1), expected);
@@ -150,8 +150,8 @@ TEST(FrictionalFluidTest, ShearUnderConfiningPressure) {
   MaterialPoint pt = MakeMaterialPoint(Material{"sand", 1800, p});
   for (int n = 0; n < 10; ++n) StepMaterialPoint(pt, 1.0 * Mat3::Identity(), 1e-4);  // J > 1
   StepMaterialPoint(pt, SimpleShear(10), 1e-4);
-  EXPECT_GT(pt.particles.stress[0].trace(), 0);
-  EXPECT_NEAR(pt.particles.stress[0](0, 1), 50 * std::cos(p.friction_angle) + 10 * p.viscosity,
+  EXPECT_GT(pt.particles.stress[0].matrix().trace(), 0);
+  EXPECT_NEAR(pt.particles.stress[0].matrix()(0, 1), 50 * std::cos(p.friction_angle) + 10 * p.viscosity,
               1e-12 * 100);
 }
 
@@ -165,19 +165,19 @@ TEST(ViscoplasticFluidTest, PressureFollowsTheEquationOfStateAndEnergyMatchesWor
     for (int n = 0; n < 300; ++n) {
       StepMaterialPoint(pt, (n < 200 ? -0.3 : 0.2) * Mat3::Identity(), 1e-3);
       const Real J = pt.particles.F[0].determinant();
-      const Real sigma_m = pt.particles.stress[0].trace() / 3;
+      const Real sigma_m = pt.particles.stress[0].matrix().trace() / 3;
       const Real expected = eos == EquationOfState::kLinear ? K * std::log(J) / J  // (6.1)
                                                             : -B * (std::pow(J, -p.tait_gamma) - 1);
       ASSERT_NEAR(sigma_m, expected, 1e-12 * std::abs(expected));
       // Isotropic L: dev d = 0, no deviatoric stress even at mu_eff = mu_max.
-      ASSERT_NEAR(EquivalentShear(pt.particles.stress[0]), 0, 1e-9 * std::abs(expected));
+      ASSERT_NEAR(EquivalentShear(pt.particles.stress[0].matrix()), 0, 1e-9 * std::abs(expected));
       worst = std::max(worst, std::abs(sigma_m - expected) / std::abs(expected));
       work += 0.5 * (sigma_m + sm_prev) * (J - J_prev);
       J_prev = J;
       sm_prev = sigma_m;
     }
     const Real psi = StrainEnergyDensity(pt.model.materials[0], pt.particles.F[0],
-                                         pt.particles.stress[0], pt.particles.strain[0]);
+                                         pt.particles.stress[0].matrix(), pt.particles.strain[0]);
     std::printf("Bingham %s EOS: J = %.4f, sigma_m = %.2f Pa, max rel. error %.1e; energy %.4f "
                 "vs work int sigma_m dJ %.4f J/m^3\n", eos == EquationOfState::kTait ? "Tait" : "linear",
                 J_prev, sm_prev, worst, psi, work);
@@ -212,15 +212,15 @@ TEST(ViscoplasticFluidTest, StressIsObjectiveUnderASuperposedRigidMotion) {
       StepMaterialPoint(a1, L, 1e-3);
       StepMaterialPoint(b, Q * L * Q.transpose(), 1e-3);
       StepMaterialPoint(c, Q * L * Q.transpose() + omega, 1e-3);
-      const Mat3 expected = Q * a1.particles.stress[0] * Q.transpose();
-      const Real scale = a1.particles.stress[0].norm();
-      const Real dev_scale = Dev(a1.particles.stress[0]).norm();
-      EXPECT_LE((b.particles.stress[0] - expected).norm(), 1e-12 * scale);
+      const Mat3 expected = Q * a1.particles.stress[0].matrix() * Q.transpose();
+      const Real scale = a1.particles.stress[0].matrix().norm();
+      const Real dev_scale = Dev(a1.particles.stress[0].matrix()).norm();
+      EXPECT_LE((b.particles.stress[0].matrix() - expected).norm(), 1e-12 * scale);
       EXPECT_NEAR(b.particles.history[0][0], a1.particles.history[0][0], 1e-14);
-      EXPECT_LE((Dev(c.particles.stress[0]) - Dev(expected)).norm(), 1e-12 * dev_scale);
+      EXPECT_LE((Dev(c.particles.stress[0].matrix()) - Dev(expected)).norm(), 1e-12 * dev_scale);
       EXPECT_NEAR(c.particles.history[0][0], a1.particles.history[0][0], 1e-14);
-      worst = std::max(worst, (b.particles.stress[0] - expected).norm() / scale);
-      worst_dev = std::max(worst_dev, (Dev(c.particles.stress[0]) - Dev(expected)).norm() / dev_scale);
+      worst = std::max(worst, (b.particles.stress[0].matrix() - expected).norm() / scale);
+      worst_dev = std::max(worst_dev, (Dev(c.particles.stress[0].matrix()) - Dev(expected)).norm() / dev_scale);
     }
   }
   std::printf("fluid objectivity: max |sigma' - Q sigma Q^T| / |sigma| = %.2e (rotated frame); "

@@ -31,7 +31,7 @@ Real YoungsModulus(const J2Params& p) {
   return 9 * p.bulk_modulus * p.shear_modulus / (3 * p.bulk_modulus + p.shear_modulus);
 }
 
-Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0]; }
+Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix(); }
 
 Real YieldRadius(const J2Params& p, const History& h) {
   return std::sqrt(2.0 / 3.0) * (p.yield_stress + p.isotropic_hardening * h[kJ2PlasticStrain]);
@@ -87,7 +87,7 @@ TEST_P(J2DriverTest, RigidRotationLeavesInvariantsUnchanged) {
   std::uniform_real_distribution<Real> angle(-3.0, 3.0);
   Real worst = 0;
   for (int r = 0; r < 20; ++r) {
-    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 sigma0 = pt.particles.stress[0].matrix();
     const Mat3 beta0 = J2BackStressOf(pt.particles.history[0]);
     const Real alpha0 = pt.particles.history[0][kJ2PlasticStrain];
     const Vec3 axis = Vec3(angle(rng), angle(rng), angle(rng)).normalized();
@@ -95,14 +95,14 @@ TEST_P(J2DriverTest, RigidRotationLeavesInvariantsUnchanged) {
     StepMaterialPoint(pt, (R - Mat3::Identity()) / dt, dt);  // f = I + dt L = R exactly
 
     const Real scale = sigma0.norm();
-    const Vec3 i0 = Invariants(sigma0), i1 = Invariants(pt.particles.stress[0]);
+    const Vec3 i0 = Invariants(sigma0), i1 = Invariants(pt.particles.stress[0].matrix());
     const Vec3 tol = 1e-10 * Vec3(scale, scale * scale, scale * scale * scale);
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(i1[i], i0[i], tol[i]) << "invariant " << i;
-    EXPECT_LE((pt.particles.stress[0] - R * sigma0 * R.transpose()).norm(), 1e-10 * scale);
+    EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(), 1e-10 * scale);
     const Mat3 beta1 = J2BackStressOf(pt.particles.history[0]);
     EXPECT_LE((beta1 - R * beta0 * R.transpose()).norm(), 1e-10 * scale);
     EXPECT_NEAR(pt.particles.history[0][kJ2PlasticStrain], alpha0, 1e-12 * alpha0);
-    worst = std::max(worst, (pt.particles.stress[0] - R * sigma0 * R.transpose()).norm() / scale);
+    worst = std::max(worst, (pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm() / scale);
   }
   std::printf("J2 k=%g H=%g: rigid rotations, max |sigma - R sigma0 R^T| / |sigma0| = %.2e\n",
               p.isotropic_hardening, p.kinematic_hardening, worst);
@@ -115,7 +115,7 @@ void UniaxialStep(MaterialPoint& pt, Real stretch_ratio, Real dt, Real stress_to
   auto lateral_stress = [&](Real x, MaterialPoint& trial) {
     trial = pt;
     StepMaterialPoint(trial, Vec3(axial, x, x).asDiagonal().toDenseMatrix(), dt);
-    return trial.particles.stress[0](1, 1);
+    return trial.particles.stress[0].matrix()(1, 1);
   };
   MaterialPoint trial;
   Real x0 = -0.5 * axial, x1 = -0.3 * axial;
@@ -159,7 +159,7 @@ TEST_P(J2DriverTest, MixedControlDriverReproducesUniaxialTension) {
     const Real exact = UniaxialTau(p, log_strain);
     worst = std::max(worst, std::abs(Tau(pt)(0, 0) - exact) / exact);
     ASSERT_NEAR(Tau(pt)(0, 0), exact, 1e-7 * exact) << "log strain " << log_strain;
-    const Mat3& sigma = pt.particles.stress[0];
+    const Mat3& sigma = pt.particles.stress[0].matrix();
     ASSERT_LE((sigma - sigma(0, 0) * Vec3(1, 0, 0).asDiagonal().toDenseMatrix()).cwiseAbs().maxCoeff(), tol);
   }
   std::printf("J2 k=%g H=%g: mixed-control uniaxial, max rel. error %.2e, <= %d iterations\n",
@@ -237,7 +237,7 @@ TEST(J2DriverTest, StoredEnergyMatchesStressWorkAndDissipationIsPositive) {
     const Mat3 d = Sym(L);
     work += 0.5 * ((tau0 + Tau(pt)).array() * d.array()).sum() * dt;
     const Real psi = StrainEnergyDensity(pt.model.materials[0], pt.particles.F[0],
-                                         pt.particles.stress[0], pt.particles.strain[0]);
+                                         pt.particles.stress[0].matrix(), pt.particles.strain[0]);
     psi_max = std::max(psi_max, psi);  // errors relative to the largest energy so far
     if (step < 1000) {
       ASSERT_EQ(pt.particles.history[0][kJ2PlasticStrain], 0) << "the slow phase must be elastic";
@@ -249,7 +249,7 @@ TEST(J2DriverTest, StoredEnergyMatchesStressWorkAndDissipationIsPositive) {
   std::printf("J2 energy: elastic |psi - W| / psi_max <= %.2e; plastic (W - psi) / psi_max >= %.2e; "
               "final W - psi = %.4e J/m^3\n", worst_elastic, min_dissipation,
               work - StrainEnergyDensity(pt.model.materials[0], pt.particles.F[0],
-                                         pt.particles.stress[0], pt.particles.strain[0]));
+                                         pt.particles.stress[0].matrix(), pt.particles.strain[0]));
   // f = I + dt L (2.18) is a first-order approximation of exp(dt L): the work differs from the
   // exact stress work by O(dt |L|) relative, hence the tolerances 10 dt |L|.
   EXPECT_LT(worst_elastic, 10 * dt * slow);
@@ -262,7 +262,7 @@ TEST(J2DriverTest, GeostaticStressIsReproducedByTheElasticState) {
   sigma0.diagonal() << -2e7, -2e7, -5e7;
   MaterialPoint pt = MakeMaterialPoint(J2Material(p), sigma0);
   StepMaterialPoint(pt, Mat3::Zero(), 1e-6);  // f = I: the stress must come back unchanged
-  EXPECT_LE((pt.particles.stress[0] - sigma0).norm(), 1e-12 * sigma0.norm());
+  EXPECT_LE((pt.particles.stress[0].matrix() - sigma0).norm(), 1e-12 * sigma0.norm());
   EXPECT_EQ(pt.particles.history[0][kJ2PlasticStrain], 0);
 }
 
@@ -285,7 +285,7 @@ TEST(NewtonianFluidDriverTest, PressureFollowsKLnJ) {
     const Mat3 L = rate * Mat3::Identity();
     StepMaterialPoint(pt, L, dt);
     const Real J = pt.particles.F[0].determinant();
-    const Mat3 sigma = pt.particles.stress[0];
+    const Mat3 sigma = pt.particles.stress[0].matrix();
     const Real expected = K * std::log(J) / J;  // (6.1) with theta = ln J, rho = rho0 / J
     worst = std::max(worst, std::abs(sigma.trace() / 3 - 2 * mu * rate - expected) / std::abs(expected));
     ASSERT_NEAR(sigma.trace() / 3 - 2 * mu * rate, expected, 1e-12 * std::abs(expected));
@@ -302,14 +302,14 @@ TEST(NewtonianFluidDriverTest, SimpleShearStressIsTwoMuD) {
   L(0, 1) = gamma_dot;
   for (int n = 0; n < 100; ++n) {
     StepMaterialPoint(pt, L, dt);
-    const Mat3& sigma = pt.particles.stress[0];
+    const Mat3& sigma = pt.particles.stress[0].matrix();
     // f = I + dt L is unimodular: J = 1, no pressure; d12 = gamma_dot / 2.
     EXPECT_NEAR(sigma(0, 1), 2 * mu * 0.5 * gamma_dot, 1e-12 * mu * gamma_dot);
     EXPECT_NEAR(sigma(1, 0), sigma(0, 1), 0);
     EXPECT_NEAR(sigma.diagonal().norm(), 0, 1e-3 * mu * gamma_dot);
   }
   std::printf("fluid simple shear: sigma12 = %.6f Pa (2 mu d12 = %.6f Pa)\n",
-              pt.particles.stress[0](0, 1), mu * gamma_dot);
+              pt.particles.stress[0].matrix()(0, 1), mu * gamma_dot);
 }
 
 TEST(NewtonianFluidDriverTest, TaitEquationOfState) {
@@ -320,7 +320,7 @@ TEST(NewtonianFluidDriverTest, TaitEquationOfState) {
   for (int n = 0; n < 300; ++n) {
     StepMaterialPoint(pt, -10.0 * Mat3::Identity(), dt);  // compress to J ~ 0.91
     const Real J = pt.particles.F[0].determinant();
-    const Real sigma_m = pt.particles.stress[0].trace() / 3;
+    const Real sigma_m = pt.particles.stress[0].matrix().trace() / 3;
     const Real p = B * (std::pow(1 / J, gamma) - 1);  // p = B [(rho/rho0)^gamma - 1]
     worst = std::max(worst, std::abs(-sigma_m - p) / p);
     ASSERT_NEAR(-sigma_m, p, 1e-12 * p);
@@ -329,7 +329,7 @@ TEST(NewtonianFluidDriverTest, TaitEquationOfState) {
     sm_prev = sigma_m;
   }
   const Real psi = StrainEnergyDensity(pt.model.materials[0], pt.particles.F[0],
-                                       pt.particles.stress[0], pt.particles.strain[0]);
+                                       pt.particles.stress[0].matrix(), pt.particles.strain[0]);
   std::printf("fluid (Tait): J = %.4f, p = %.4e Pa, max rel. error %.2e, energy %.6e vs work %.6e\n",
               J_prev, -sm_prev, worst, psi, work);
   EXPECT_NEAR(psi, work, 1e-5 * psi);

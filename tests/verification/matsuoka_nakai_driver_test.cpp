@@ -58,7 +58,7 @@ Material SandMaterial(const MatsuokaNakaiParams &p) {
 }
 
 Mat3 Tau(const MaterialPoint &pt) {
-  return pt.particles.F[0].determinant() * pt.particles.stress[0];
+  return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix();
 }
 const History &Hist(const MaterialPoint &pt) { return pt.particles.history[0]; }
 Vec3 Principal(const Mat3 &a) {
@@ -294,7 +294,7 @@ TEST_P(MatsuokaNakaiDriverTest, EveryReturnEndsOnTheFrozenYieldSurface) {
       const History before = Hist(pt);
       // Deviatoric random rate plus a volumetric rate that pulls p back towards
       // -150 kPa.
-      const Real p_now = pt.particles.stress[0].trace() / 3;
+      const Real p_now = pt.particles.stress[0].matrix().trace() / 3;
       const Real sign = step % 600 < 300
                             ? 1
                             : -1; // sustained shear, reversed every 300 steps
@@ -399,21 +399,21 @@ TEST_P(MatsuokaNakaiDriverTest,
   std::uniform_real_distribution<Real> angle(-3.0, 3.0);
   Real worst = 0;
   for (int r = 0; r < 20; ++r) {
-    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 sigma0 = pt.particles.stress[0].matrix();
     const History h0 = Hist(pt);
     const Vec3 axis = Vec3(angle(rng), angle(rng), angle(rng)).normalized();
     const Mat3 R = Eigen::AngleAxis<Real>(angle(rng), axis).toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / dt, dt); // f = R exactly
     const Real scale = sigma0.norm();
-    const Vec3 e0 = Principal(sigma0), e1 = Principal(pt.particles.stress[0]);
+    const Vec3 e0 = Principal(sigma0), e1 = Principal(pt.particles.stress[0].matrix());
     EXPECT_LE((e1 - e0).norm(), 1e-10 * scale);
-    EXPECT_LE((pt.particles.stress[0] - R * sigma0 * R.transpose()).norm(),
+    EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(),
               1e-10 * scale);
     for (int i = 0; i < kHistorySlots; ++i)
       EXPECT_EQ(Hist(pt)[i], h0[i]) << "slot " << i;
     worst = std::max(
         worst,
-        (pt.particles.stress[0] - R * sigma0 * R.transpose()).norm() / scale);
+        (pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm() / scale);
   }
   std::printf(
       "%s: rigid rotations, max |sigma - R sigma0 R^T| / |sigma0| = %.1e\n",
@@ -499,7 +499,7 @@ TEST_P(MatsuokaNakaiDriverTest, TensionCutoffReturnsToTheApex) {
             1e-9 * p.cohesion);
   EXPECT_GT(Hist(pt)[kMnLambda], 0);
   std::printf("%s: tension cutoff, sigma = %.6g kPa 1, lambda = %.2e\n",
-              PotentialName(GetParam()), pt.particles.stress[0](0, 0) / 1e3,
+              PotentialName(GetParam()), pt.particles.stress[0].matrix()(0, 0) / 1e3,
               Hist(pt)[kMnLambda]);
 }
 
@@ -522,7 +522,7 @@ TEST_P(MatsuokaNakaiDriverTest, GeostaticStartIsOnOrInsideTheSurface) {
     }
     StepMaterialPoint(pt, Mat3::Zero(),
                       1e-3); // no deformation: nothing changes
-    EXPECT_LE((pt.particles.stress[0] - sigma).norm(), 1e-9 * sigma.norm());
+    EXPECT_LE((pt.particles.stress[0].matrix() - sigma).norm(), 1e-9 * sigma.norm());
   }
 }
 

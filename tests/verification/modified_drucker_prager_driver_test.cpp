@@ -39,7 +39,7 @@ ModifiedDruckerPragerParams SeedSand(Real cohesion = 0, bool zero_dilation = fal
   return p;
 }
 Material Sand(const ModifiedDruckerPragerParams& p) { return Material{"sand", 2000.0, p}; }
-Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0]; }
+Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix(); }
 using testing::RandomL;
 // Plastic volumetric strain ln J^p = ln J - tr(eps_e), eps_e = 1/2 ln b^e.
 Real PlasticVolume(const MaterialPoint& pt) {
@@ -78,7 +78,7 @@ TEST(ModifiedDruckerPragerTest, ReturnsLandOnTheFrozenConeAndAnglesFollowTheLaws
       worst = std::max(worst, std::abs(f) / scale);
       ASSERT_LE(std::abs(f), 1e-8 * scale) << "step " << step;
       // (3.113)-(3.114), (3.112) of the stored lambda and the converged I1 (Cauchy).
-      const Real I1 = pt.particles.stress[0].trace();
+      const Real I1 = pt.particles.stress[0].matrix().trace();
       EXPECT_NEAR(h[kMdpFriction], MobilisedFrictionDeg(p.friction, I1, h[kMdpLambda]), 1e-12);
       EXPECT_NEAR(h[kMdpCritical], CriticalFrictionDeg(p.friction, h[kMdpLambda]), 1e-12);
       EXPECT_NEAR(h[kMdpDilation], DilationAngleDeg(h[kMdpFriction], h[kMdpCritical]), 1e-12);
@@ -102,12 +102,12 @@ TEST(ModifiedDruckerPragerTest, RigidRotationLeavesInvariantsAndHistoryUnchanged
   ASSERT_GT(pt.particles.history[0][kMdpLambda], 0);
   std::uniform_real_distribution<Real> u(-3.0, 3.0);
   for (int r = 0; r < 10; ++r) {
-    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 sigma0 = pt.particles.stress[0].matrix();
     const History h0 = pt.particles.history[0];
     const Mat3 R =
         Eigen::AngleAxis<Real>(u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / 1e-4, 1e-4);  // f = R
-    EXPECT_LE((pt.particles.stress[0] - R * sigma0 * R.transpose()).norm(), 1e-10 * sigma0.norm());
+    EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(), 1e-10 * sigma0.norm());
     for (int i = 0; i < kHistorySlots; ++i) EXPECT_EQ(pt.particles.history[0][i], h0[i]);
   }
 }
@@ -199,7 +199,7 @@ TEST(ModifiedDruckerPragerTest, HydrostaticTensionReturnsToTheApex) {
   // Zero mobilised angle (Table 3.5 i at lambda = 0 in tension): no apex, no division by zero.
   MaterialPoint zero = MakeMaterialPoint(Sand(SeedSand(0)), Mat3::Zero());
   StepMaterialPoint(zero, 0.1 * Mat3::Identity(), 1e-1);
-  EXPECT_TRUE(zero.particles.stress[0].allFinite());
+  EXPECT_TRUE(zero.particles.stress[0].matrix().allFinite());
 }
 
 TEST(ModifiedDruckerPragerTest, ShearingPathPeaksAtLambdaStarAndEndsAtA0) {
@@ -212,7 +212,7 @@ TEST(ModifiedDruckerPragerTest, ShearingPathPeaksAtLambdaStarAndEndsAtA0) {
   const Real phi_star = a.a0 + a.a1 / a.a3 * std::exp(-1 - a.a3 * a.a4 / a.a1);
   MaterialPoint pt = MakeMaterialPoint(Sand(p), -100e3 * Mat3::Identity());
   History h0;
-  InitialPlasticHistory(p, pt.particles.stress[0], h0);
+  InitialPlasticHistory(p, pt.particles.stress[0].matrix(), h0);
   pt.particles.history[0] = h0;
   EXPECT_NEAR(h0[kMdpFriction], a.a0 - a.a4, 1e-12) << "geostatic start: phi_F(I1, 0)";
   MixedControl m;

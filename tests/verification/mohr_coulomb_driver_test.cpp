@@ -51,7 +51,7 @@ Material MaterialOf(const MohrCoulombParams& p) { return Material{"sand", 2000.0
 Material MaterialOf(const TrescaParams& p) { return Material{"clay", 1800.0, p}; }
 
 Mat3 Tau(const MaterialPoint& pt) {
-  return pt.particles.F[0].determinant() * pt.particles.stress[0];
+  return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix();
 }
 const History& Hist(const MaterialPoint& pt) { return pt.particles.history[0]; }
 McRegion RegionOf(const MaterialPoint& pt) {
@@ -288,16 +288,16 @@ TEST_P(MohrCoulombDriverTest, RigidRotationLeavesInvariantsUnchanged) {
   std::uniform_real_distribution<Real> angle(-3.0, 3.0);
   Real worst = 0;
   for (int r = 0; r < 20; ++r) {
-    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 sigma0 = pt.particles.stress[0].matrix();
     const History h0 = Hist(pt);
     const Vec3 axis = Vec3(angle(rng), angle(rng), angle(rng)).normalized();
     const Mat3 R = Eigen::AngleAxis<Real>(angle(rng), axis).toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / dt, dt);
     const Real scale = sigma0.norm();
-    const Real err = (pt.particles.stress[0] - R * sigma0 * R.transpose()).norm() / scale;
+    const Real err = (pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm() / scale;
     worst = std::max(worst, err);
     EXPECT_LE(err, 1e-10);
-    EXPECT_LE((Principal(pt.particles.stress[0]) - Principal(sigma0)).norm(), 1e-10 * scale);
+    EXPECT_LE((Principal(pt.particles.stress[0].matrix()) - Principal(sigma0)).norm(), 1e-10 * scale);
     EXPECT_EQ(RegionOf(pt), McRegion::kElastic);
     EXPECT_EQ(Hist(pt)[kMcPlasticStrain], h0[kMcPlasticStrain]);
   }
@@ -319,8 +319,8 @@ TEST_P(MohrCoulombDriverTest, PermutedPathGivesPermutedStress) {
     const Mat3 L = path.Next();
     StepMaterialPoint(a, L, dt);
     StepMaterialPoint(b, P * L * P.transpose(), dt);
-    const Mat3 sa = P * a.particles.stress[0] * P.transpose();
-    const Real err = (b.particles.stress[0] - sa).norm() / sa.norm();
+    const Mat3 sa = P * a.particles.stress[0].matrix() * P.transpose();
+    const Real err = (b.particles.stress[0].matrix() - sa).norm() / sa.norm();
     worst = std::max(worst, err);
     ASSERT_LE(err, 1e-9) << "step " << step;
   }

@@ -30,7 +30,7 @@ SmoothCapDruckerPragerParams Debris(Real phi_deg, Real mu, Real associativity = 
   return SmoothCapDruckerPragerParams{8.33e6, 3.85e6, DruckerPragerSlope(Radians(phi_deg)), mu,
                                       associativity};
 }
-Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0]; }
+Mat3 Tau(const MaterialPoint& pt) { return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix(); }
 
 TEST(SmoothCapDruckerPragerTest, ReturnsLandOnTheSurfaceInEveryRegion) {
   for (const Real phi : {5.0, 20.0, 40.0}) {
@@ -119,11 +119,11 @@ TEST(SmoothCapDruckerPragerTest, RigidRotationIsObjective) {
   }
   ASSERT_GT(pt.particles.history[0][kScdpPlasticStrain], 0);
   for (int r = 0; r < 10; ++r) {
-    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 sigma0 = pt.particles.stress[0].matrix();
     const Mat3 R = Eigen::AngleAxis<Real>(3 * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized())
                        .toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / 1e-4, 1e-4);
-    EXPECT_LE((pt.particles.stress[0] - R * sigma0 * R.transpose()).norm(), 1e-10 * sigma0.norm());
+    EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(), 1e-10 * sigma0.norm());
   }
 }
 

@@ -35,7 +35,7 @@ SnowParams WetSnow() { return FromYoungs(1e6, 0.3, 1.0, 0.1, 0.5, 1.5e3); }
 Material SnowMaterial(const SnowParams& p) { return Material{"snow", 300.0, p}; }
 
 Mat3 Tau(const MaterialPoint& pt) {
-  return pt.particles.F[0].determinant() * pt.particles.stress[0];
+  return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix();
 }
 Real MeanPressure(const Mat3& tau) { return -tau.trace() / 3; }  // p, compression positive
 Real ShearStress(const Mat3& tau) { return std::sqrt(1.5) * Dev(tau).norm(); }  // q
@@ -99,12 +99,12 @@ TEST_P(SnowDriverTest, RigidRotationLeavesInvariantsUnchanged) {
   std::uniform_real_distribution<Real> angle(-3.0, 3.0);
   Real worst = 0;
   for (int r = 0; r < 20; ++r) {
-    const Mat3 sigma0 = pt.particles.stress[0];
+    const Mat3 sigma0 = pt.particles.stress[0].matrix();
     const History h0 = Hist(pt);
     const Vec3 axis = Vec3(angle(rng), angle(rng), angle(rng)).normalized();
     const Mat3 R = Eigen::AngleAxis<Real>(angle(rng), axis).toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / dt, dt);  // f = I + dt L = R exactly
-    const Mat3 sigma1 = pt.particles.stress[0];
+    const Mat3 sigma1 = pt.particles.stress[0].matrix();
     const Real scale = sigma0.norm();
     EXPECT_NEAR(sigma1.trace(), sigma0.trace(), 1e-10 * scale);
     EXPECT_NEAR(Dev(sigma1).norm(), Dev(sigma0).norm(), 1e-10 * scale);
@@ -200,11 +200,11 @@ TEST_P(SnowDriverTest, HydrostaticTensionYieldsAtMinusBetaP0ThenLosesCohesion) {
               "plastic p = %.2f Pa; final p0 = %.3g Pa, |sigma| = %.3g Pa; closed-form error "
               "%.1e\n",
               Name(), min_p, -beta * p0i, first_plastic_p, Hist(pt)[kSnowConsolidation],
-              pt.particles.stress[0].norm(), worst);
+              pt.particles.stress[0].matrix().norm(), worst);
   EXPECT_GE(min_p, -beta * p0i * (1 + 1e-12));  // never beyond the tensile strength
   EXPECT_LE(min_p, -beta * p0i * (1 - 1e-2));   // and it reaches it
   EXPECT_EQ(Hist(pt)[kSnowConsolidation], 0);   // ln J = 0.24 > a0 + elastic: cohesion gone
-  EXPECT_LE(pt.particles.stress[0].norm(), 1e-12 * p0i);
+  EXPECT_LE(pt.particles.stress[0].matrix().norm(), 1e-12 * p0i);
 }
 
 // Simple shear at constant mean stress (xx, yy, zz stress-controlled, spec §2.10): the stress
@@ -252,7 +252,7 @@ TEST_P(SnowDriverTest, ShearAtConstantPReachesTheCriticalState) {
                 pt.particles.F[0].determinant(), p.consolidation_pressure,
                 Hist(pt)[kSnowConsolidation], plastic);
     EXPECT_NEAR(ratio, ratio_cs, 0.01 * ratio_cs);
-    EXPECT_NEAR(MeanPressure(pt.particles.stress[0]), pm, 1e-8 * pm);
+    EXPECT_NEAR(MeanPressure(pt.particles.stress[0].matrix()), pm, 1e-8 * pm);
     EXPECT_EQ(wrong_sign, 0);
     EXPECT_EQ(outside, 0);
     EXPECT_GT(plastic, 1000);
@@ -291,7 +291,7 @@ TEST_P(SnowDriverTest, GeostaticStartIsOnOrInsideTheSurface) {
       EXPECT_NEAR(h0[kSnowConsolidation], p.consolidation_pressure, 1e-12 * p.consolidation_pressure);
     }
     StepMaterialPoint(pt, Mat3::Zero(), 1e-3);
-    const Real err = (pt.particles.stress[0] - sigma).norm() / sigma.norm();
+    const Real err = (pt.particles.stress[0].matrix() - sigma).norm() / sigma.norm();
     std::printf("snow %s: geostatic sigma_v = %.0f Pa (K0 = 0.5): p0 = %.0f Pa (%s), y/scale = "
                 "%.1e, |sigma - sigma_0|/|sigma_0| after f = I: %.1e\n",
                 Name(), depth_stress, h0[kSnowConsolidation], outside ? "raised" : "p0_init",

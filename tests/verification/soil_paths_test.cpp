@@ -96,14 +96,14 @@ Row Step(MaterialPoint &pt, const MixedControl &c, Real strain,
       continue;
     const int i = kVoigtI[v], j = kVoigtJ[v];
     r0 = std::max(r0,
-                  std::abs(first.particles.stress[0](i, j) - c.target(i, j)));
+                  std::abs(first.particles.stress[0].matrix()(i, j) - c.target(i, j)));
   }
   const Real tol =
       std::max(1e-7 * r0, 1e-11 * std::abs(kP0)); // below 1e-6 r0 with margin
   const int iterations = MixedControlStep(pt, c, kDt, tol);
   EXPECT_GE(iterations, 0) << "mixed control did not converge at strain "
                            << strain;
-  const Mat3 &s = pt.particles.stress[0];
+  const Mat3 &s = pt.particles.stress[0].matrix();
   Real err = 0;
   for (int v = 0; v < 6; ++v) {
     if (!c.stress_controlled[v])

@@ -86,7 +86,7 @@ Checkpoint FullCheckpoint(size_t n) {
     P.body[p] = int32_t(p % 2);
     P.id[p] = int64_t(1e12) + int64_t(p);
   }
-  if (n > 0) P.stress[0](1, 2) = std::numeric_limits<Real>::quiet_NaN();
+  if (n > 0) P.stress[0].v[4] = std::numeric_limits<Real>::quiet_NaN();  // yz
   s.groups = {{0, 0, n / 2}, {2, n / 2, n}};
   s.rigid = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
   c.bullet = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
@@ -303,6 +303,39 @@ TEST_F(CheckpointTest, OptionalArraysRoundTripByLayout) {
                 SameBytes(P.elastic_b, Q.elastic_b) && SameBytes(P.history, Q.history) &&
                 SameBytes(P.ext_force, Q.ext_force) && SameBytes(P.id, Q.id))
         << mask;
+  }
+}
+
+// Checkpoints written before 2026-12-03 hold the stress as (N, 9) column-major matrices; they are
+// still read, into the 6 stored components (the file is edited through HDF5, so it is read
+// without its checksum).
+TEST_F(CheckpointTest, NineComponentStressOfOlderCheckpointsIsRead) {
+  const Checkpoint c = FullCheckpoint(5);
+  const std::string path = (dir_ / "nine.h5").string();
+  WriteCheckpoint(path, c);
+  std::vector<Mat3> full(5);
+  for (size_t p = 0; p < 5; ++p) full[p] = Mat3(c.state.particles.stress[p]) + Mat3::Identity();
+  {
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    H5Ldelete(f, "particles/stress", H5P_DEFAULT);
+    const hsize_t dims[2] = {5, 9};
+    const hid_t space = H5Screate_simple(2, dims, nullptr);
+    const hid_t d = H5Dcreate2(f, "particles/stress", H5T_IEEE_F64LE, space, H5P_DEFAULT,
+                               H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, full.data());
+    H5Dclose(d);
+    H5Sclose(space);
+    H5Fclose(f);
+  }
+  const Checkpoint r = ReadCheckpoint(path, /*verify_checksum=*/false);
+  ASSERT_EQ(r.state.particles.stress.size(), 5u);
+  for (size_t p = 0; p < 5; ++p) {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (std::isnan(full[p](i, j)))  // FullCheckpoint's NaN in particle 0 (yz)
+          EXPECT_TRUE(std::isnan(r.state.particles.stress[p](i, j))) << p << " " << i << j;
+        else
+          EXPECT_EQ(r.state.particles.stress[p](i, j), full[p](i, j)) << p << " " << i << j;
   }
 }
 

@@ -58,10 +58,11 @@ State TinyState(size_t n) {
   }
   if (n > 0) {
     P.F[0](0, 0) = 1.1;
-    P.stress[0] = -3.0 * Mat3::Identity();
-    P.stress[0](0, 1) = P.stress[0](1, 0) = 2.0;
-    P.stress[0](1, 2) = P.stress[0](2, 1) = 0.5;  // yz
-    P.stress[0](0, 2) = P.stress[0](2, 0) = 0.25;  // xz
+    Mat3 s = -3.0 * Mat3::Identity();
+    s(0, 1) = s(1, 0) = 2.0;
+    s(1, 2) = s(2, 1) = 0.5;  // yz
+    s(0, 2) = s(2, 0) = 0.25;  // xz
+    P.stress[0] = s;
   }
   return s;
 }

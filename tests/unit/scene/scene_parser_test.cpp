@@ -731,7 +731,7 @@ TEST(SceneParserTest, SmoothCapDruckerPragerKeysAndJakyK0) {
       WithMaterial(sc + "friction_angle_deg: 30, yield_stress: 10}") +
           "    initial_stress: {geostatic: {k0: jaky}}\n" + "gravity: [0, -10, 0]\n",
       "ok.yaml");
-  const Mat3& sigma = s.state.particles.stress[0];
+  const Mat3& sigma = s.state.particles.stress[0].matrix();
   ASSERT_LT(sigma(1, 1), 0);
   EXPECT_NEAR(sigma(0, 0) / sigma(1, 1), 0.5, 1e-12);
   EXPECT_NE(s.resolved_yaml.find("k0: jaky"), std::string::npos) << s.resolved_yaml;
