@@ -312,25 +312,20 @@ void ReadArray(hid_t loc, const char* name, hid_t mem_type, size_t rows, size_t 
   }
 }
 
-// The number of rows of a dataset.
-size_t Rows(hid_t loc, const char* name, const std::string& path) {
-  Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
-  Require(ds.ok(), std::string("open ") + name, path);
-  Handle space(H5Dget_space(ds.get()), H5Sclose);
-  hsize_t dims[H5S_MAX_RANK] = {};  // any rank fits; ReadArray checks it
-  Require(H5Sget_simple_extent_dims(space.get(), dims, nullptr) >= 1, std::string("read ") + name,
-          path);
-  return size_t(dims[0]);
-}
-
-// The number of columns of a rank-2 dataset (0 for any other rank).
-size_t Cols(hid_t loc, const char* name, const std::string& path) {
+// Rows and columns of a dataset (columns 0 unless its rank is 2); any rank fits, ReadArray
+// checks it.
+std::pair<size_t, size_t> Shape(hid_t loc, const char* name, const std::string& path) {
   Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
   Require(ds.ok(), std::string("open ") + name, path);
   Handle space(H5Dget_space(ds.get()), H5Sclose);
   hsize_t dims[H5S_MAX_RANK] = {};
   const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
-  return rank == 2 ? size_t(dims[1]) : 0;
+  Require(rank >= 1, std::string("read ") + name, path);
+  return {size_t(dims[0]), rank == 2 ? size_t(dims[1]) : 0};
+}
+
+size_t Rows(hid_t loc, const char* name, const std::string& path) {
+  return Shape(loc, name, path).first;
 }
 
 }  // namespace
@@ -526,26 +521,26 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
     const hid_t d = H5T_NATIVE_DOUBLE;
     ReadArray(l, "x", d, n, 3, P.x, path);
     ReadArray(l, "v", d, n, 3, P.v, path);
-    P.layout.affine = H5Lexists(l, "C", H5P_DEFAULT) > 0;
-    if (P.layout.affine) ReadArray(l, "C", d, n, 9, P.C, path);
+    // An optional array (Particles::layout) is held when the checkpoint has it.
+    const auto read_optional = [&](const char* name, size_t cols, bool& held, auto& array) {
+      held = H5Lexists(l, name, H5P_DEFAULT) > 0;
+      if (held) ReadArray(l, name, d, n, cols, array, path);
+    };
+    read_optional("C", 9, P.layout.affine, P.C);
     ReadArray(l, "F", d, n, 9, P.F, path);
-    if (Cols(l, "stress", path) == 9) {  // written before 2026-12-03: the full matrix
+    if (Shape(l, "stress", path).second == 9) {  // written before 2026-12-03: the full matrix
       std::vector<Mat3> full;
       ReadArray(l, "stress", d, n, 9, full, path);
       P.stress.assign(full.begin(), full.end());
     } else {
       ReadArray(l, "stress", d, n, 6, P.stress, path);
     }
-    P.layout.strain = H5Lexists(l, "strain", H5P_DEFAULT) > 0;
-    if (P.layout.strain) ReadArray(l, "strain", d, n, 9, P.strain, path);
-    P.layout.elastic_b = H5Lexists(l, "elastic_b", H5P_DEFAULT) > 0;
-    if (P.layout.elastic_b) ReadArray(l, "elastic_b", d, n, 9, P.elastic_b, path);
-    P.layout.history = H5Lexists(l, "history", H5P_DEFAULT) > 0;
-    if (P.layout.history) ReadArray(l, "history", d, n, kHistorySlots, P.history, path);
+    read_optional("strain", 9, P.layout.strain, P.strain);
+    read_optional("elastic_b", 9, P.layout.elastic_b, P.elastic_b);
+    read_optional("history", kHistorySlots, P.layout.history, P.history);
     ReadArray(l, "mass", d, n, 0, P.mass, path);
     ReadArray(l, "volume0", d, n, 0, P.volume0, path);
-    P.layout.ext_force = H5Lexists(l, "ext_force", H5P_DEFAULT) > 0;
-    if (P.layout.ext_force) ReadArray(l, "ext_force", d, n, 3, P.ext_force, path);
+    read_optional("ext_force", 3, P.layout.ext_force, P.ext_force);
     ReadArray(l, "material", H5T_NATIVE_INT32, n, 0, P.material, path);
     ReadArray(l, "body", H5T_NATIVE_INT32, n, 0, P.body, path);
     ReadArray(l, "id", H5T_NATIVE_INT64, n, 0, P.id, path);

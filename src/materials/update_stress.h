@@ -22,9 +22,8 @@ void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_
                     History& history);
 
 // The optional particle arrays a run with these materials needs (Particles::layout): C for APIC
-// transfers, strain for
-// linear_elastic, b^e for the elastoplastic models, history for those and the yield-stress fluids,
-// ext_force when a body has tractions.
+// transfers, strain for linear_elastic, b^e for the elastoplastic models, history for those and
+// the yield-stress fluids, ext_force when a body has tractions.
 ParticleLayout ParticleLayoutFor(const Model& model, bool tractions);
 
 // Stored elastic energy sum psi V0 [J] (per metre of thickness in 2-D), summed in fixed chunks.

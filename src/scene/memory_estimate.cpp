@@ -41,7 +41,8 @@ double ReadNumber(const char* path) {
 double BytesPerParticle(const ParticleLayout& layout) {
   using P = Particles;
   // State: every Particles array the layout holds.
-  double b = Elem<decltype(P::x)>() + Elem<decltype(P::v)>() + Elem<decltype(P::F)>() + Elem<decltype(P::stress)>() + Elem<decltype(P::mass)>() +
+  double b = Elem<decltype(P::x)>() + Elem<decltype(P::v)>() + Elem<decltype(P::F)>() +
+             Elem<decltype(P::stress)>() + Elem<decltype(P::mass)>() +
              Elem<decltype(P::volume0)>() + Elem<decltype(P::material)>() +
              Elem<decltype(P::body)>() + Elem<decltype(P::id)>();
   if (layout.affine) b += Elem<decltype(P::C)>();
