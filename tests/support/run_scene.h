@@ -3,6 +3,8 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,20 @@ namespace surge::testing {
 
 inline std::string ScenePath(const std::string& name) {
   return std::string(SURGE_SOURCE_DIR) + "/scenes/" + name;
+}
+
+// Scene overrides for by-hand studies: the comma-separated key=value list in environment variable
+// `name` (as `surge run --set`), appended to `out`. Nothing when the variable is unset.
+inline std::vector<std::string> EnvOverrides(const char* name, std::vector<std::string> out = {}) {
+  if (const char* extra = std::getenv(name)) {
+    const std::string all(extra);
+    for (size_t begin = 0; begin <= all.size();) {
+      const size_t end = std::min(all.find(',', begin), all.size());
+      if (end > begin) out.push_back(all.substr(begin, end - begin));
+      begin = end + 1;
+    }
+  }
+  return out;
 }
 
 template <typename Observe>

@@ -19,6 +19,7 @@
 // (issue 3).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -50,6 +51,7 @@ Band HeightBandDp(Real a) {
 
 struct Extents {
   Real l = 0, h = 0;  // eq. (7.8) [m]
+  Real top = 0;       // highest particle at the symmetry line + s / 2 [m]
 };
 
 // Eq. (7.8): extents of a rectangular distribution from the mass centroid of the particles in
@@ -58,7 +60,7 @@ struct Extents {
 // velocity is interpolated from the stopped floor nodes, and deposited material rests on it.
 // At the symmetry line, within one particle spacing.
 Extents MeasureExtents(const Particles& P, Real cell, Real spacing) {
-  Real floor_mx = 0, floor_m = 0, axis_my = 0, axis_m = 0;
+  Real floor_mx = 0, floor_m = 0, axis_my = 0, axis_m = 0, top = 0;
   for (size_t p = 0; p < P.size(); ++p) {
     if (P.x[p].y() < cell) {
       floor_mx += P.mass[p] * P.x[p].x();
@@ -67,9 +69,10 @@ Extents MeasureExtents(const Particles& P, Real cell, Real spacing) {
     if (P.x[p].x() < spacing) {
       axis_my += P.mass[p] * P.x[p].y();
       axis_m += P.mass[p];
+      top = std::max(top, P.x[p].y() + spacing / 2);
     }
   }
-  return {2 * floor_mx / floor_m, 2 * axis_my / axis_m};
+  return {2 * floor_mx / floor_m, 2 * axis_my / axis_m, top};
 }
 
 Real KineticEnergy(const Particles& P) {
@@ -80,6 +83,7 @@ Real KineticEnergy(const Particles& P) {
 
 struct Collapse {
   Real runout = 0, height = 0;        // L_f, H_f of (7.7)-(7.8) [-]
+  Real top = 0;                       // top of the deposit at the symmetry line / l0 [-]
   Real front_runout = 0;              // (max x - l0) / l0 [-]
   Real kinetic_peak = 0, kinetic_end = 0;  // [J/m]
   size_t particles = 0;
@@ -90,6 +94,7 @@ Collapse RunCollapse(Real a, const std::vector<std::string>& extra = {}) {
   std::vector<std::string> overrides = {"parameters.a=" + std::to_string(a),
                                         "bodies.0.particles_per_cell=2"};
   overrides.insert(overrides.end(), extra.begin(), extra.end());
+  overrides = testing::EnvOverrides("SURGE_COLLAPSE_SET", overrides);  // by-hand studies
   LoadedScene scene = LoadScene(testing::ScenePath("column_collapse_2d.yaml"), overrides);
   Collapse c;
   c.particles = scene.state.particles.size();
@@ -97,10 +102,11 @@ Collapse RunCollapse(Real a, const std::vector<std::string>& extra = {}) {
     ++c.steps;
     if (c.steps % 50 == 0) c.kinetic_peak = std::max(c.kinetic_peak, KineticEnergy(s.particles));
   });
-  const Real spacing = scene.model.dx / 2;  // 2 particles per cell per axis
+  const Real spacing = std::sqrt(scene.state.particles.volume0.at(0));  // volume0 = s^2 in 2-D
   const Extents e = MeasureExtents(scene.state.particles, scene.model.dx, spacing);
   c.runout = (e.l - kL0) / kL0;  // (7.7)
   c.height = e.h / kL0;
+  c.top = e.top / kL0;
   c.kinetic_end = KineticEnergy(scene.state.particles);
   Real front = 0;
   for (const Vec3& x : scene.state.particles.x) front = std::max(front, x.x());
@@ -113,10 +119,10 @@ TEST(ColumnCollapseTest, RunoutInsideTheSeedBoundsAndDepositsAtRest) {
     const Collapse c = RunCollapse(a);
     const Band lb = RunoutBandDp(a), hb = HeightBandDp(a);
     std::printf("column collapse a = %.2g (%zu particles, %ld steps): front runout L_f = %.3f (DP "
-                "bounds %.3f-%.3f); (7.8) L_f = %.3f, H_f = %.3f (DP bounds %.3f-%.3f); kinetic "
-                "energy at end %.2e of peak\n",
+                "bounds %.3f-%.3f); (7.8) L_f = %.3f, H_f = %.3f (DP bounds %.3f-%.3f); top at the "
+                "axis %.3f; kinetic energy at end %.2e of peak\n",
                 a, c.particles, c.steps, c.front_runout, lb.lower(a), lb.upper(a), c.runout,
-                c.height, hb.lower(a), hb.upper(a), c.kinetic_end / c.kinetic_peak);
+                c.height, hb.lower(a), hb.upper(a), c.top, c.kinetic_end / c.kinetic_peak);
     EXPECT_LT(c.kinetic_end, 1e-3 * c.kinetic_peak) << "a = " << a << ": the deposit must be at rest";
     EXPECT_GE(c.front_runout, lb.lower(a)) << "a = " << a;
     EXPECT_LE(c.front_runout, lb.upper(a)) << "a = " << a;

@@ -81,15 +81,8 @@ Sample Measure(const State& s, Real spacing, const std::vector<char>& top) {
 // Scene overrides: the coarse CI set unless SURGE_TAYLOR_FULL=1, then any extra overrides from
 // SURGE_TAYLOR_SET (comma-separated key=value, as `surge run --set`; for sensitivity studies).
 std::vector<std::string> Overrides(const std::vector<std::string>& coarse) {
-  std::vector<std::string> out = FullResolution() ? std::vector<std::string>{} : coarse;
-  if (const char* extra = std::getenv("SURGE_TAYLOR_SET")) {
-    std::string all(extra);
-    for (size_t begin = 0; begin <= all.size();) {
-      const size_t end = std::min(all.find(',', begin), all.size());
-      if (end > begin) out.push_back(all.substr(begin, end - begin));
-      begin = end + 1;
-    }
-  }
+  const std::vector<std::string> out = testing::EnvOverrides(
+      "SURGE_TAYLOR_SET", FullResolution() ? std::vector<std::string>{} : coarse);
   for (const std::string& o : out) std::printf("  --set %s\n", o.c_str());
   return out;
 }
