@@ -112,6 +112,7 @@ struct TimeControl {
 struct BodyInfo {
   std::string name;
   int material = 0;
+  int antilocking = 0;  // index into Model::antilocking: its material's, or its own override
 };
 
 // Frictional contact between two MPM bodies (scene key `body_contact`): each body listed in a
@@ -162,7 +163,9 @@ struct Model {
   bool wall_gap_test = true;
   ExitPolicy exit_policy = ExitPolicy::kRemove;
   std::vector<Material> materials;
-  std::vector<AntiLocking> antilocking;  // per material (index as materials); empty = none
+  // One per material (index as materials), then one per body that overrides its material's
+  // (BodyInfo::antilocking, MaterialGroup::antilocking); empty = none.
+  std::vector<AntiLocking> antilocking;
   std::vector<BulkViscosity> bulk_viscosity;  // per material (index as materials); empty = none
   LocalDamping damping;                  // scene key `damping` (off by default)
   MassScaling mass_scaling;              // scene key `mass_scaling` (off by default)

@@ -9,11 +9,16 @@
 namespace surge {
 
 // A contiguous particle range [begin, end) of one material (particles are grouped by material,
-// so UpdateStress does one std::visit per group and then a monomorphic loop).
+// so UpdateStress does one std::visit per group and then a monomorphic loop) and one anti-locking
+// setting (each group is projected over its own particles only): bodies of one material share a
+// group unless a body overrides the material's anti-locking.
 struct MaterialGroup {
   int material = 0;
   size_t begin = 0;
   size_t end = 0;
+  int antilocking = -1;  // index into Model::antilocking; -1: the material's own (index material)
+
+  int AntiLockingIndex() const { return antilocking < 0 ? material : antilocking; }
 };
 
 struct State {

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -420,8 +421,9 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
         groups.push_back(m.material);
         groups.push_back(int64_t(m.begin));
         groups.push_back(int64_t(m.end));
+        groups.push_back(m.antilocking);
       }
-      WriteArray(f, "groups", H5T_STD_I64LE, H5T_NATIVE_INT64, groups.data(), s.groups.size(), 3,
+      WriteArray(f, "groups", H5T_STD_I64LE, H5T_NATIVE_INT64, groups.data(), s.groups.size(), 4,
                  tmp);
       WriteDoubles(f, "rigid", FlattenRigid(s.rigid).data(), s.rigid.size(), kRigidColumns, tmp);
       WriteDoubles(f, "bullet", FlattenRigid(c.bullet).data(), c.bullet.size(), kRigidColumns, tmp);
@@ -546,12 +548,24 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
     ReadArray(l, "id", H5T_NATIVE_INT64, n, 0, P.id, path);
   }
   {
-    std::vector<std::array<int64_t, 3>> groups;
-    ReadArray(f, "groups", H5T_NATIVE_INT64, Rows(f, "groups", path), 3, groups, path);
+    // (material, begin, end, anti-locking setting); before per-body anti-locking (2026-12-03)
+    // without the setting, which was the material's (-1).
+    std::vector<std::array<int64_t, 4>> groups;
+    const auto [rows, cols] = Shape(f, "groups", path);
+    if (cols == 3) {
+      std::vector<std::array<int64_t, 3>> old;
+      ReadArray(f, "groups", H5T_NATIVE_INT64, rows, 3, old, path);
+      for (const auto& g : old) groups.push_back({g[0], g[1], g[2], -1});
+    } else {
+      ReadArray(f, "groups", H5T_NATIVE_INT64, rows, 4, groups, path);
+    }
     for (const auto& g : groups) {
       if (g[1] < 0 || g[2] < g[1] || size_t(g[2]) > s.particles.size())
         throw IoError("checkpoint '" + path + "': a material group lies outside the particles");
-      s.groups.push_back(MaterialGroup{int(g[0]), size_t(g[1]), size_t(g[2])});
+      if (g[0] < 0 || g[0] > std::numeric_limits<int>::max() || g[3] < -1 ||
+          g[3] > std::numeric_limits<int>::max())
+        throw IoError("checkpoint '" + path + "': a material group has an invalid index");
+      s.groups.push_back(MaterialGroup{int(g[0]), size_t(g[1]), size_t(g[2]), int(g[3])});
     }
     const auto read_rigid = [&](const char* name) {
       std::vector<std::array<double, kRigidColumns>> rows;

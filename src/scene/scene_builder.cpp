@@ -10,6 +10,7 @@
 #include <memory>
 #include <numbers>
 #include <type_traits>
+#include <utility>
 #include <variant>
 #include <string>
 
@@ -342,7 +343,14 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   if (spec.damping.until) model.damping.until = *spec.damping.until;
   model.mass_scaling.factor = spec.mass_scaling.factor;
   if (spec.mass_scaling.until) model.mass_scaling.until = *spec.mass_scaling.until;
-  for (const BodySpec& b : spec.bodies) model.bodies.push_back(BodyInfo{b.name, b.material_index});
+  for (const BodySpec& b : spec.bodies) {
+    int antilocking = b.material_index;  // the material's setting
+    if (b.antilocking) {                 // the body's own (docs/antilocking.md, "Per body")
+      antilocking = static_cast<int>(model.antilocking.size());
+      model.antilocking.push_back(ResolvedAntiLocking(spec, b));
+    }
+    model.bodies.push_back(BodyInfo{b.name, b.material_index, antilocking});
+  }
   for (size_t o = 0; o < spec.obstacles.size(); ++o) model.obstacles.push_back(BuildObstacle(spec, o));
   for (const SensorSpec& s : spec.sensors) model.sensors.push_back(Sensor{s.name, s.min, s.max});
   // Body contacts: the bodies named in a pair get a velocity field each (in body order), all
@@ -428,8 +436,9 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
     CheckMemory(spec, total, box, model.field_count, layout, "");
   }
 
-  // Lay the particles out grouped by material, bodies in file order within a group: the same
-  // order as a stable sort of the seeding order by material index.
+  // Lay the particles out grouped by material, then by anti-locking setting (the material's
+  // first, then the bodies' own in file order), bodies in file order within a group: without
+  // per-body settings the same order as a stable sort of the seeding order by material index.
   state = State{};
   for (Obstacle& o : model.obstacles) {  // dynamic bodies start at their reference pose
     if (o.motion.kind != ObstacleMotionKind::kDynamic) continue;
@@ -443,10 +452,14 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   Mat3 unused_b;  // InitialHistory's outputs for a layout without b^e or history
   History unused_history;
   size_t next = 0;
-  for (size_t m = 0; m < spec.materials.size(); ++m) {
+  std::vector<std::pair<int, int>> keys;  // (material, anti-locking setting) in layout order
+  for (const BodyInfo& b : model.bodies) keys.emplace_back(b.material, b.antilocking);
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  for (const auto& [m, setting] : keys) {
     const size_t begin = next;
     for (size_t b = 0; b < spec.bodies.size(); ++b) {
-      if (spec.bodies[b].material_index != static_cast<int>(m)) continue;
+      if (model.bodies[b].material != m || model.bodies[b].antilocking != setting) continue;
       const SeededBody& s = seeded[b];
       for (size_t k = 0; k < s.x.size(); ++k, ++next) {
         P.x[next] = s.x[k];
@@ -455,7 +468,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
         P.F[next] = Mat3::Identity();
         P.stress[next] = s.stress[k];
         if (P.layout.strain) P.strain[next] = Mat3::Zero();
-        InitialHistory(model.materials[m], s.stress[k],
+        InitialHistory(model.materials[size_t(m)], s.stress[k],
                        P.layout.elastic_b ? P.elastic_b[next] : unused_b,
                        P.layout.history ? P.history[next] : unused_history);
         P.mass[next] = s.mass;
@@ -466,7 +479,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
         P.id[next] = first_id[b] + static_cast<int64_t>(k);
       }
     }
-    if (next > begin) state.groups.push_back(MaterialGroup{static_cast<int>(m), begin, next});
+    if (next > begin) state.groups.push_back(MaterialGroup{m, begin, next, setting});
   }
 }
 

@@ -479,6 +479,7 @@ class Parser {
 
   Wall ParseWall(const YAML::Node& n, const std::string& path) const;
   MaterialSpec ParseMaterial(const YAML::Node& n, const std::string& path) const;
+  AntiLockingSpec ParseAntiLocking(const YAML::Node& al, const std::string& ap) const;
   void ParseElasticPair(const YAML::Node& n, const std::string& path, MaterialSpec& m) const;
   RegionShape ParseRegion(const YAML::Node& n, const std::string& path) const;
   BodySpec ParseBody(const YAML::Node& n, const std::string& path, const SceneSpec& spec) const;
@@ -539,6 +540,59 @@ std::vector<std::string> MaterialKeys(const MaterialKind& kind) {
   return keys;
 }
 
+// antilocking: {method: none | node | cell | hybrid | smoothing, approach: volumetric |
+// volumetric_deviatoric | constant_volumetric, strain: total | increment, stress: false | true}
+// (docs/antilocking.md), of a material or a body.
+AntiLockingSpec Parser::ParseAntiLocking(const YAML::Node& al, const std::string& ap) const {
+  AntiLockingSpec a;
+  ExpectMap(al, ap, {"method", "approach", "strain", "stress"});
+  a.method = Enum(Need(al, ap, "method"), Child(ap, "method"), kAntiLockingNames);
+  const bool hybrid = *a.method == AntiLockingMethod::kHybrid;
+  // Hybrid is node-based volumetric plus cell-based deviatoric (seed (4.33)-(4.35)): a full
+  // tensor approximation by definition.
+  a.approach =
+      hybrid ? AntiLockingApproach::kVolumetricDeviatoric : AntiLockingApproach::kVolumetric;
+  if (const YAML::Node an = al["approach"]) {
+    a.approach = Enum(an, Child(ap, "approach"), kAntiLockingApproachNames);
+    const bool full = a.approach != AntiLockingApproach::kVolumetric;
+    if (hybrid && a.approach != AntiLockingApproach::kVolumetricDeviatoric) {
+      Fail(an, Child(ap, "approach"),
+           "method hybrid takes the trace from node-based and the deviator from cell-based "
+           "control volumes (seed (4.33)-(4.35)): approach volumetric_deviatoric (or leave it out)");
+    }
+    if (full && *a.method == AntiLockingMethod::kSmoothing) {
+      Fail(an, Child(ap, "approach"),
+           "strain smoothing (Anura3D manual §6.7) smooths the volumetric strain only: approach "
+           "volumetric (or leave it out)");
+    }
+    if (full && *a.method == AntiLockingMethod::kNone) {
+      Fail(an, Child(ap, "approach"), "approach " + an.Scalar() +
+                                         " needs a control volume: method node, cell or hybrid");
+    }
+  }
+  // Anura3D smooths the strain rate (manual (6.34)-(6.37)): the increment by default.
+  if (*a.method == AntiLockingMethod::kSmoothing) a.strain = AntiLockingStrain::kIncrement;
+  if (al["strain"]) {
+    a.strain = Enum(al["strain"], Child(ap, "strain"), kAntiLockingStrainNames);
+  }
+  if (const YAML::Node st = al["stress"]) {
+    a.stress = Bool(st, Child(ap, "stress"));
+    if (a.stress && *a.method == AntiLockingMethod::kNone) {
+      Fail(st, Child(ap, "stress"), "stress averaging needs a control volume: method node or cell");
+    }
+    if (a.stress && *a.method == AntiLockingMethod::kSmoothing) {
+      Fail(st, Child(ap, "stress"),
+           "stress averaging is implemented for method node or cell only, not for smoothing");
+    }
+    if (a.stress && a.approach != AntiLockingApproach::kVolumetric) {
+      Fail(st, Child(ap, "stress"),
+           "stress averaging is implemented for the volumetric approach only (method node or "
+           "cell, approach volumetric)");
+    }
+  }
+  return a;
+}
+
 MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path) const {
   MaterialSpec m;
   m.loc = Loc(n, path);
@@ -580,55 +634,7 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
     m.values[d.key] = static_cast<Real>(it - choices.begin());
   }
   if (const YAML::Node al = n["antilocking"]) {
-    // antilocking: {method: none | node | cell | hybrid, approach: volumetric |
-    // volumetric_deviatoric | constant_volumetric, strain: total | increment, stress: false | true}
-    // (docs/antilocking.md).
-    const std::string ap = Child(path, "antilocking");
-    ExpectMap(al, ap, {"method", "approach", "strain", "stress"});
-    m.antilocking = Enum(Need(al, ap, "method"), Child(ap, "method"), kAntiLockingNames);
-    const bool hybrid = *m.antilocking == AntiLockingMethod::kHybrid;
-    // Hybrid is node-based volumetric plus cell-based deviatoric (seed (4.33)-(4.35)): a full
-    // tensor approximation by definition.
-    m.antilocking_approach =
-        hybrid ? AntiLockingApproach::kVolumetricDeviatoric : AntiLockingApproach::kVolumetric;
-    if (const YAML::Node a = al["approach"]) {
-      m.antilocking_approach = Enum(a, Child(ap, "approach"), kAntiLockingApproachNames);
-      const bool full = m.antilocking_approach != AntiLockingApproach::kVolumetric;
-      if (hybrid && m.antilocking_approach != AntiLockingApproach::kVolumetricDeviatoric) {
-        Fail(a, Child(ap, "approach"),
-             "method hybrid takes the trace from node-based and the deviator from cell-based "
-             "control volumes (seed (4.33)-(4.35)): approach volumetric_deviatoric (or leave it out)");
-      }
-      if (full && *m.antilocking == AntiLockingMethod::kSmoothing) {
-        Fail(a, Child(ap, "approach"),
-             "strain smoothing (Anura3D manual §6.7) smooths the volumetric strain only: approach "
-             "volumetric (or leave it out)");
-      }
-      if (full && *m.antilocking == AntiLockingMethod::kNone) {
-        Fail(a, Child(ap, "approach"), "approach " + a.Scalar() +
-                                           " needs a control volume: method node, cell or hybrid");
-      }
-    }
-    // Anura3D smooths the strain rate (manual (6.34)-(6.37)): the increment by default.
-    if (*m.antilocking == AntiLockingMethod::kSmoothing) m.antilocking_strain = AntiLockingStrain::kIncrement;
-    if (al["strain"]) {
-      m.antilocking_strain = Enum(al["strain"], Child(ap, "strain"), kAntiLockingStrainNames);
-    }
-    if (const YAML::Node st = al["stress"]) {
-      m.antilocking_stress = Bool(st, Child(ap, "stress"));
-      if (m.antilocking_stress && *m.antilocking == AntiLockingMethod::kNone) {
-        Fail(st, Child(ap, "stress"), "stress averaging needs a control volume: method node or cell");
-      }
-      if (m.antilocking_stress && *m.antilocking == AntiLockingMethod::kSmoothing) {
-        Fail(st, Child(ap, "stress"),
-             "stress averaging is implemented for method node or cell only, not for smoothing");
-      }
-      if (m.antilocking_stress && m.antilocking_approach != AntiLockingApproach::kVolumetric) {
-        Fail(st, Child(ap, "stress"),
-             "stress averaging is implemented for the volumetric approach only (method node or "
-             "cell, approach volumetric)");
-      }
-    }
+    m.antilocking = ParseAntiLocking(al, Child(path, "antilocking"));
   }
   if (const YAML::Node bv = n["bulk_viscosity"]) {
     // bulk_viscosity: {quadratic: c0, linear: c1} (docs/antilocking.md, "Artificial bulk
@@ -822,7 +828,7 @@ BodySpec Parser::ParseBody(const YAML::Node& n, const std::string& path,
   b.loc = Loc(n, path);
   ExpectMap(n, path,
             {"name", "material", "region", "particles_per_cell", "jitter", "seed", "velocity",
-             "initial_stress", "tractions"});
+             "initial_stress", "tractions", "antilocking"});
   b.name = Identifier(Need(n, path, "name"), Child(path, "name"));
   const YAML::Node mat = Need(n, path, "material");
   b.material = String(mat, Child(path, "material"));
@@ -849,6 +855,9 @@ BodySpec Parser::ParseBody(const YAML::Node& n, const std::string& path,
         Integer(n["seed"], Child(path, "seed"), 0, std::numeric_limits<int64_t>::max()));
   }
   if (n["velocity"]) b.velocity = Vector(n["velocity"], Child(path, "velocity"), "m/s");
+  if (const YAML::Node al = n["antilocking"]) {
+    b.antilocking = ParseAntiLocking(al, Child(path, "antilocking"));
+  }
   if (n["initial_stress"]) {
     const YAML::Node is = n["initial_stress"];
     const std::string ip = Child(path, "initial_stress");
@@ -1539,11 +1548,11 @@ SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
 
 AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
   AntiLocking a;
-  a.strain = m.antilocking_strain;
-  a.approach = m.antilocking_approach;
-  a.stress = m.antilocking_stress;
-  if (m.antilocking) {
-    a.method = *m.antilocking;
+  a.strain = m.antilocking.strain;
+  a.approach = m.antilocking.approach;
+  a.stress = m.antilocking.stress;
+  if (m.antilocking.method) {
+    a.method = *m.antilocking.method;
   } else {
     // Node-based for the nearly incompressible Newtonian fluid (seed ch. 4 requires anti-locking
     // for it, §3.7 prefers node-based for wall forces); none for solids and, until verified with
@@ -1555,6 +1564,27 @@ AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
   }
   return a;
 }
+
+AntiLocking ResolvedAntiLocking(const SceneSpec& spec, const BodySpec& b) {
+  if (!b.antilocking) return ResolvedAntiLocking(spec.materials.at(size_t(b.material_index)));
+  // A body's own setting always names its method (ParseAntiLocking requires it).
+  return AntiLocking{*b.antilocking->method, b.antilocking->approach, b.antilocking->strain,
+                     b.antilocking->stress};
+}
+
+namespace {
+
+// `antilocking: {method, approach, strain[, stress]}` in full (stress only when on).
+void EmitAntiLocking(YAML::Emitter& e, const AntiLocking& al) {
+  e << YAML::Key << "antilocking" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+    << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
+    << "approach" << YAML::Value << NameOf(kAntiLockingApproachNames, al.approach) << YAML::Key
+    << "strain" << YAML::Value << NameOf(kAntiLockingStrainNames, al.strain);
+  if (al.stress) e << YAML::Key << "stress" << YAML::Value << true;
+  e << YAML::EndMap;
+}
+
+}  // namespace
 
 void EmitObstacle(YAML::Emitter& e, const ObstacleSpec& o, int dim) {
   e << YAML::BeginMap;
@@ -1721,14 +1751,7 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
         e << d.choices[static_cast<size_t>(it->second)];
       }
     }
-    const AntiLocking al = ResolvedAntiLocking(m);
-    e << YAML::Key << "antilocking" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
-      << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
-      << "approach" << YAML::Value << NameOf(kAntiLockingApproachNames, al.approach)
-      << YAML::Key << "strain" << YAML::Value
-      << NameOf(kAntiLockingStrainNames, al.strain);
-    if (al.stress) e << YAML::Key << "stress" << YAML::Value << true;  // only when on
-    e << YAML::EndMap;
+    EmitAntiLocking(e, ResolvedAntiLocking(m));
     if (m.bulk_viscosity.enabled) {  // only when on (resolved scenes without it stay the same)
       e << YAML::Key << "bulk_viscosity" << YAML::Value << YAML::Flow << YAML::BeginMap
         << YAML::Key << "quadratic" << YAML::Value << Num(m.bulk_viscosity.quadratic)
@@ -1756,6 +1779,7 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
         << YAML::Value << (b.k0_from_friction ? std::string("jaky") : Num(*b.geostatic_k0))
         << YAML::EndMap << YAML::EndMap;
     }
+    if (b.antilocking) EmitAntiLocking(e, ResolvedAntiLocking(spec, b));  // only when overridden
     e << YAML::Key << "tractions" << YAML::Value;
     if (b.tractions.empty()) e << YAML::Flow;
     e << YAML::BeginSeq;

@@ -73,6 +73,14 @@ enum class MaterialModel {
   kDruckerPrager,
 };
 
+// `antilocking: {method, approach, strain, stress}` of a material or a body (docs/antilocking.md).
+struct AntiLockingSpec {
+  std::optional<AntiLockingMethod> method;  // unset: the default of the material's class
+  AntiLockingApproach approach = AntiLockingApproach::kVolumetric;
+  AntiLockingStrain strain = AntiLockingStrain::kTotal;
+  bool stress = false;  // `stress: true`: Table 4.1 steps 6-7
+};
+
 struct MaterialSpec {
   std::string name;  // the key under `materials`
   MaterialModel model = MaterialModel::kLinearElastic;
@@ -87,12 +95,9 @@ struct MaterialSpec {
   // The model's own keys (MaterialKind::params) as written in the file; an enumerated key holds
   // the index of its choice. Keys not written take their default through Param().
   std::map<std::string, Real, std::less<>> values;
-  // `antilocking: {method, approach, strain}` (docs/antilocking.md); method unset = the default
-  // of the material's class, ResolvedAntiLocking().
-  std::optional<AntiLockingMethod> antilocking;
-  AntiLockingStrain antilocking_strain = AntiLockingStrain::kTotal;
-  AntiLockingApproach antilocking_approach = AntiLockingApproach::kVolumetric;
-  bool antilocking_stress = false;  // `antilocking: {stress: true}`: Table 4.1 steps 6-7
+  // `antilocking` (docs/antilocking.md); method unset = the default of the material's class,
+  // ResolvedAntiLocking(). A body may override it (BodySpec::antilocking).
+  AntiLockingSpec antilocking;
   // `bulk_viscosity: {quadratic, linear}` (docs/antilocking.md); disabled when not written.
   BulkViscosity bulk_viscosity;
   SourceLoc loc;
@@ -182,6 +187,9 @@ struct BodySpec {
   std::optional<Real> geostatic_k0;  // initial_stress: {geostatic: {k0}}
   bool k0_from_friction = false;     // k0 was given as `jaky`: 1 - sin(phi) of the material
   std::vector<TractionSpec> tractions;
+  // `antilocking`: this body's own setting, replacing its material's (written in full, method
+  // required); unset: the material's (docs/antilocking.md, "Per body").
+  std::optional<AntiLockingSpec> antilocking;
   SourceLoc loc;         // the body's map
   SourceLoc region_loc;  // the `region` map
 };
@@ -296,6 +304,8 @@ SceneSpec ParseSceneSpec(const std::string& text, const std::string& source,
 // Anti-locking of a material: as written, else node-based volumetric on the total strain for the
 // Newtonian fluid (smooth pressure and wall forces, seed §3.7) and none for every other model.
 AntiLocking ResolvedAntiLocking(const MaterialSpec& m);
+// Anti-locking of a body: its own setting when it has one, else its material's.
+AntiLocking ResolvedAntiLocking(const SceneSpec& spec, const BodySpec& b);
 
 // The analysis settings of a scene with the defaults filled in (docs/scene-reference.md,
 // `analysis`): `written` is spec.analysis.settings, possibly changed by the caller (the options

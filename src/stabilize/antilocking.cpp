@@ -655,8 +655,8 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
               "anti-locking needs x_n and L_p of every particle");
   std::vector<Mat3>& L = velocity_gradient;
   for (const MaterialGroup& g : groups) {
-    if (g.end == g.begin || size_t(g.material) >= model.antilocking.size()) continue;
-    const AntiLocking& al = model.antilocking[g.material];
+    if (g.end == g.begin || size_t(g.AntiLockingIndex()) >= model.antilocking.size()) continue;
+    const AntiLocking& al = model.antilocking[size_t(g.AntiLockingIndex())];
     const AntiLockingMethod method = al.method;
     if (method == AntiLockingMethod::kNone) continue;
     Mode mode;
@@ -701,8 +701,8 @@ void ProjectMeanStress(const Model& model, const StepContext& ctx,
   SURGE_CHECK(x_n.size() == particles.size(), "stress averaging needs x_n of every particle");
   Particles& P = particles;
   for (const MaterialGroup& g : groups) {
-    if (g.end == g.begin || size_t(g.material) >= model.antilocking.size()) continue;
-    const AntiLocking& a = model.antilocking[g.material];
+    if (g.end == g.begin || size_t(g.AntiLockingIndex()) >= model.antilocking.size()) continue;
+    const AntiLocking& a = model.antilocking[size_t(g.AntiLockingIndex())];
     if (a.method == AntiLockingMethod::kNone || !a.stress) continue;
     DispatchProjection(model, a.method, [&]<int kDim, class K, bool kNode>() {
       // The seed projects the specific stress sigma-bar = tau / rho0 (Table 4.1 step 6, (4.25)_2,

@@ -315,8 +315,11 @@ void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, s
   const Material& mat = m.materials[size_t(P.material[p])];
   const std::string body =
       size_t(P.body[p]) < m.bodies.size() ? m.bodies[size_t(P.body[p])].name : "?";
-  const bool antilocked = size_t(P.material[p]) < m.antilocking.size() &&
-                          m.antilocking[size_t(P.material[p])].method != AntiLockingMethod::kNone;
+  const size_t setting = size_t(P.body[p]) < m.bodies.size()
+                            ? size_t(m.bodies[size_t(P.body[p])].antilocking)
+                            : size_t(P.material[p]);
+  const bool antilocked = setting < m.antilocking.size() &&
+                          m.antilocking[setting].method != AntiLockingMethod::kNone;
   // Stiffest material with particles: its wave speed bounds the stable step from above.
   Real c_max = 0;
   std::string stiffest;

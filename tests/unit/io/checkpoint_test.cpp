@@ -87,7 +87,7 @@ Checkpoint FullCheckpoint(size_t n) {
     P.id[p] = int64_t(1e12) + int64_t(p);
   }
   if (n > 0) P.stress[0].v[4] = std::numeric_limits<Real>::quiet_NaN();  // yz
-  s.groups = {{0, 0, n / 2}, {2, n / 2, n}};
+  s.groups = {{0, 0, n / 2}, {2, n / 2, n, 3}};  // the second with a body's own anti-locking
   s.rigid = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
   c.bullet = {{vec(), mat(), vec(), vec()}, {vec(), mat(), vec(), vec()}};
   c.bulk_viscosity_q.assign(n, 0);
@@ -150,6 +150,8 @@ TEST_F(CheckpointTest, RoundTripIsBitwise) {
     EXPECT_EQ(r.state.groups[1].material, 2);
     EXPECT_EQ(r.state.groups[1].begin, n / 2);
     EXPECT_EQ(r.state.groups[1].end, n);
+    EXPECT_EQ(r.state.groups[0].antilocking, -1);
+    EXPECT_EQ(r.state.groups[1].antilocking, 3);
     EXPECT_TRUE(SameRigid(r.state.rigid, c.state.rigid));
     EXPECT_TRUE(SameRigid(r.bullet, c.bullet));
     EXPECT_TRUE(SameBytes(r.bulk_viscosity_q, c.bulk_viscosity_q));
@@ -337,6 +339,38 @@ TEST_F(CheckpointTest, NineComponentStressOfOlderCheckpointsIsRead) {
         else
           EXPECT_EQ(r.state.particles.stress[p](i, j), full[p](i, j)) << p << " " << i << j;
   }
+}
+
+// Checkpoints written before per-body anti-locking hold (material, begin, end) per group: each
+// group then has its material's own setting.
+TEST_F(CheckpointTest, ThreeColumnGroupsOfOlderCheckpointsAreRead) {
+  Checkpoint c = FullCheckpoint(6);
+  c.state.groups = {{0, 0, 2}, {1, 2, 6, 4}};
+  const std::string path = (dir_ / "groups3.h5").string();
+  WriteCheckpoint(path, c);
+  {
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    H5Ldelete(f, "groups", H5P_DEFAULT);
+    const int64_t rows[2][3] = {{0, 0, 2}, {1, 2, 6}};
+    const hsize_t dims[2] = {2, 3};
+    const hid_t space = H5Screate_simple(2, dims, nullptr);
+    const hid_t d = H5Dcreate2(f, "groups", H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT,
+                               H5P_DEFAULT);
+    H5Dwrite(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows);
+    H5Dclose(d);
+    H5Sclose(space);
+    H5Fclose(f);
+  }
+  const Checkpoint r = ReadCheckpoint(path, /*verify_checksum=*/false);
+  ASSERT_EQ(r.state.groups.size(), 2u);
+  EXPECT_EQ(r.state.groups[1].material, 1);
+  EXPECT_EQ(r.state.groups[1].end, 6u);
+  EXPECT_EQ(r.state.groups[1].antilocking, -1);
+  EXPECT_EQ(r.state.groups[1].AntiLockingIndex(), 1);
+  // And the current form keeps the setting.
+  const std::string now = (dir_ / "groups4.h5").string();
+  WriteCheckpoint(now, c);
+  EXPECT_EQ(ReadCheckpoint(now).state.groups[1].antilocking, 4);
 }
 
 TEST_F(CheckpointTest, MalformedShapesAreRefusedNamingThePath) {

@@ -841,6 +841,59 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   EXPECT_EQ(again.model.antilocking[0].strain, AntiLockingStrain::kIncrement);
 }
 
+// A body's own anti-locking replaces its material's (docs/antilocking.md, "Per body"): the same
+// keys and errors, under the body's path; bodies of one material with different settings get
+// separate particle groups, each projected over its own particles.
+TEST(SceneParserTest, AntiLockingPerBody) {
+  const std::string water =
+      "  water: {model: newtonian_fluid, density: 1000, bulk_modulus: 2e7, viscosity: 0}\n";
+  const std::string three_bodies = Replace(kBase3, "bodies:\n", water + "bodies:\n") +
+                                   "  - name: plain\n"
+                                   "    material: water\n"
+                                   "    region: {box: {min: [1.5, 1.5, 1.5], max: [2, 2, 2]}}\n"
+                                   "    antilocking: {method: none}\n"
+                                   "  - name: pool\n"
+                                   "    material: water\n"
+                                   "    region: {box: {min: [-1, -1, -1], max: [-0.5, -0.5, -0.5]}}\n";
+  const LoadedScene s = LoadSceneFromString(three_bodies, "ok.yaml");
+  // Materials steel (none) and water (node), then the body override.
+  ASSERT_EQ(s.model.antilocking.size(), 3u);
+  EXPECT_EQ(s.model.antilocking[1].method, AntiLockingMethod::kNode);
+  EXPECT_EQ(s.model.antilocking[2].method, AntiLockingMethod::kNone);
+  ASSERT_EQ(s.model.bodies.size(), 3u);
+  EXPECT_EQ(s.model.bodies[0].antilocking, 0);  // steel's own
+  EXPECT_EQ(s.model.bodies[1].antilocking, 2);  // the override
+  EXPECT_EQ(s.model.bodies[2].antilocking, 1);  // water's own
+  // Groups: steel; water with its own setting (body "pool"); water with the override ("plain").
+  ASSERT_EQ(s.state.groups.size(), 3u);
+  const Particles& P = s.state.particles;
+  const int expected_body[3] = {0, 2, 1}, expected_setting[3] = {0, 1, 2};
+  for (size_t g = 0; g < 3; ++g) {
+    const MaterialGroup& group = s.state.groups[g];
+    EXPECT_EQ(group.AntiLockingIndex(), expected_setting[g]) << "group " << g;
+    ASSERT_LT(group.begin, group.end) << "group " << g;
+    for (size_t p = group.begin; p < group.end; ++p) ASSERT_EQ(P.body[p], expected_body[g]);
+  }
+  EXPECT_EQ(s.state.groups.back().end, P.size());
+  // Written back to the resolved YAML only for the body that overrides, and read back.
+  EXPECT_NE(s.resolved_yaml.find("antilocking: {method: none, approach: volumetric, strain: total}"),
+            std::string::npos)
+      << s.resolved_yaml;
+  const LoadedScene again = LoadSceneFromString(s.resolved_yaml, "again.yaml");
+  ASSERT_EQ(again.model.antilocking.size(), 3u);
+  EXPECT_EQ(again.model.bodies[1].antilocking, 2);
+  EXPECT_EQ(again.model.antilocking[2].method, AntiLockingMethod::kNone);
+  // The same checks as a material's, with the body's path.
+  ExpectError(kBase3 + "    antilocking: {approach: volumetric}\n", 12, "bodies[0].antilocking.method",
+              "missing required key 'method'");
+  ExpectError(kBase3 + "    antilocking: {method: nodes}\n", 12, "bodies[0].antilocking.method",
+              "expected one of: none, node, cell, hybrid, smoothing");
+  ExpectError(kBase3 + "    antilocking: {method: smoothing, stress: true}\n", 12,
+              "bodies[0].antilocking.stress", "not for smoothing");
+  ExpectError(kBase3 + "    antilocking: node\n", 12, "bodies[0].antilocking",
+              "expected a map with keys method, approach, strain, stress");
+}
+
 TEST(SceneParserTest, DampingKeys) {
   // damping: {local, until} at the top level (line 12, appended).
   ExpectError(kBase3 + "damping: {local: 1.0}\n", 12, "damping.local", "must be in [0, 1) [-]");
