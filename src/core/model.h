@@ -68,6 +68,11 @@ struct AntiLocking {
   AntiLockingStrain strain = AntiLockingStrain::kTotal;
   // Also project the mean stress after the stress update (seed Table 4.1 steps 6-7, optional).
   bool stress = false;
+  // Full-tensor approaches: every filtered component constant over the control volume, the
+  // seed's `ConstantAntiLocking AS2` ("does not utilize the diagonal terms in shape matrix",
+  // spec §3.3), instead of its `TriLinearAntiLocking` (S rows [1, xi, eta, zeta]). AS1 is constant
+  // either way.
+  bool constant_fit = false;
 };
 
 // Cundall's local non-viscous damping of the grid momentum balance (Anura3D manual §6.3.1, eqs.

@@ -541,11 +541,11 @@ std::vector<std::string> MaterialKeys(const MaterialKind& kind) {
 }
 
 // antilocking: {method: none | node | cell | hybrid | smoothing, approach: volumetric |
-// volumetric_deviatoric | constant_volumetric, strain: total | increment, stress: false | true}
-// (docs/antilocking.md), of a material or a body.
+// volumetric_deviatoric | constant_volumetric, fit: linear | constant, strain: total | increment,
+// stress: false | true} (docs/antilocking.md), of a material or a body.
 AntiLockingSpec Parser::ParseAntiLocking(const YAML::Node& al, const std::string& ap) const {
   AntiLockingSpec a;
-  ExpectMap(al, ap, {"method", "approach", "strain", "stress"});
+  ExpectMap(al, ap, {"method", "approach", "fit", "strain", "stress"});
   a.method = Enum(Need(al, ap, "method"), Child(ap, "method"), kAntiLockingNames);
   const bool hybrid = *a.method == AntiLockingMethod::kHybrid;
   // Hybrid is node-based volumetric plus cell-based deviatoric (seed (4.33)-(4.35)): a full
@@ -568,6 +568,21 @@ AntiLockingSpec Parser::ParseAntiLocking(const YAML::Node& al, const std::string
     if (full && *a.method == AntiLockingMethod::kNone) {
       Fail(an, Child(ap, "approach"), "approach " + an.Scalar() +
                                          " needs a control volume: method node, cell or hybrid");
+    }
+  }
+  if (const YAML::Node fit = al["fit"]) {
+    // The seed's TriLinearAntiLocking (linear) or ConstantAntiLocking (constant) of a full-tensor
+    // approach; AS1 is the constant one (spec §3.3).
+    static constexpr EnumName<bool> kFitNames[] = {{"linear", false}, {"constant", true}};
+    a.constant_fit = Enum(fit, Child(ap, "fit"), kFitNames);
+    if (*a.method == AntiLockingMethod::kNone) {
+      Fail(fit, Child(ap, "fit"), "fit needs a control volume: method node, cell or hybrid");
+    }
+    if (!a.constant_fit && a.approach == AntiLockingApproach::kVolumetric) {
+      Fail(fit, Child(ap, "fit"),
+           "the volumetric approach (AS1) projects a constant over each control volume: fit "
+           "constant (or leave it out); a linear fit needs approach volumetric_deviatoric or "
+           "constant_volumetric");
     }
   }
   // Anura3D smooths the strain rate (manual (6.34)-(6.37)): the increment by default.
@@ -1551,6 +1566,7 @@ AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
   a.strain = m.antilocking.strain;
   a.approach = m.antilocking.approach;
   a.stress = m.antilocking.stress;
+  a.constant_fit = m.antilocking.constant_fit;
   if (m.antilocking.method) {
     a.method = *m.antilocking.method;
   } else {
@@ -1569,18 +1585,22 @@ AntiLocking ResolvedAntiLocking(const SceneSpec& spec, const BodySpec& b) {
   if (!b.antilocking) return ResolvedAntiLocking(spec.materials.at(size_t(b.material_index)));
   // A body's own setting always names its method (ParseAntiLocking requires it).
   return AntiLocking{*b.antilocking->method, b.antilocking->approach, b.antilocking->strain,
-                     b.antilocking->stress};
+                     b.antilocking->stress, b.antilocking->constant_fit};
 }
 
 namespace {
 
-// `antilocking: {method, approach, strain[, stress]}` in full (stress only when on).
+// `antilocking: {method, approach, strain[, stress][, fit]}` in full (stress only when on, fit only
+// when constant for a full-tensor approach).
 void EmitAntiLocking(YAML::Emitter& e, const AntiLocking& al) {
   e << YAML::Key << "antilocking" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
     << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
     << "approach" << YAML::Value << NameOf(kAntiLockingApproachNames, al.approach) << YAML::Key
     << "strain" << YAML::Value << NameOf(kAntiLockingStrainNames, al.strain);
   if (al.stress) e << YAML::Key << "stress" << YAML::Value << true;
+  if (al.constant_fit && al.approach != AntiLockingApproach::kVolumetric) {
+    e << YAML::Key << "fit" << YAML::Value << "constant";
+  }
   e << YAML::EndMap;
 }
 

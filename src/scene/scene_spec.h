@@ -73,12 +73,14 @@ enum class MaterialModel {
   kDruckerPrager,
 };
 
-// `antilocking: {method, approach, strain, stress}` of a material or a body (docs/antilocking.md).
+// `antilocking: {method, approach, fit, strain, stress}` of a material or a body
+// (docs/antilocking.md).
 struct AntiLockingSpec {
   std::optional<AntiLockingMethod> method;  // unset: the default of the material's class
   AntiLockingApproach approach = AntiLockingApproach::kVolumetric;
   AntiLockingStrain strain = AntiLockingStrain::kTotal;
   bool stress = false;  // `stress: true`: Table 4.1 steps 6-7
+  bool constant_fit = false;  // `fit: constant`: the seed's ConstantAntiLocking
 };
 
 struct MaterialSpec {

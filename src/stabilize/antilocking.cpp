@@ -473,6 +473,9 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
   // every scatter.
   const bool node = al.method == AntiLockingMethod::kNode;
   const bool constant_trace = al.approach == AntiLockingApproach::kConstantVolumetric;
+  // `fit: constant` (the seed's ConstantAntiLocking): every component the control volume's
+  // weighted mean, as the singularity fallback (an infinite spread threshold) everywhere.
+  constexpr Real kAlwaysConstant = std::numeric_limits<Real>::infinity();
   s.moments.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(M), 0.0);
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
@@ -501,7 +504,8 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
         // made the water tank blow up within 0.3 s with the cell criteria (1e-8, 1e-10). A node
         // takes the linear fit only when its particles spread over tr C > 0.05 cell^2 (an RMS
         // spread of about 0.13 cells per axis) with det C > 1e-3 (tr C / dim)^dim.
-        F fit = CellFit<kDim>(a, Eigen::Matrix<Real, kDim, 1>::Zero(), nullptr, 0.05, 1e-3);
+        F fit = CellFit<kDim>(a, Eigen::Matrix<Real, kDim, 1>::Zero(), nullptr,
+                              al.constant_fit ? kAlwaysConstant : 0.05, 1e-3);
         if (constant_trace) fit.q[0] = a[1 + kDim + F::kSym] / a[0];  // AS3CV (4.23)
         for (int q = 0; q < Q; ++q) s.node_fit[g * Q + size_t(q)] = fit.q[q];
       }
@@ -546,7 +550,7 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
       SURGE_ASSERT(g >= 0);
       if (g < 0) continue;
       const Real* a = &s.moments[size_t(g) * M];
-      F fit = CellFit<kDim>(a, xi, nullptr);
+      F fit = CellFit<kDim>(a, xi, nullptr, al.constant_fit ? kAlwaysConstant : 1e-8);
       if (hybrid) {
         if (!std::isfinite(s.theta_bar[p])) continue;  // left to CheckState
         fit.q[0] = s.theta_bar[p];

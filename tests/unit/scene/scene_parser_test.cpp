@@ -807,7 +807,26 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   ExpectError(WithMaterial(steel + "antilocking: {method: cell, strain: trial}}"), 7,
               "materials.steel.antilocking.strain", "expected one of: total, increment");
   ExpectError(WithMaterial(steel + "antilocking: node}"), 7, "materials.steel.antilocking",
-              "expected a map with keys method, approach, strain, stress");
+              "expected a map with keys method, approach, fit, strain, stress");
+  {  // fit: the seed's ConstantAntiLocking (constant) or TriLinearAntiLocking (linear, default)
+    ExpectError(WithMaterial(steel + "antilocking: {method: cell, fit: linear}}"), 7,
+                "materials.steel.antilocking.fit", "the volumetric approach (AS1) projects a constant");
+    ExpectError(WithMaterial(steel + "antilocking: {method: none, fit: constant}}"), 7,
+                "materials.steel.antilocking.fit", "needs a control volume");
+    ExpectError(WithMaterial(steel + "antilocking: {method: cell, fit: quadratic}}"), 7,
+                "materials.steel.antilocking.fit", "expected one of: linear, constant");
+    const LoadedScene c = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: cell, approach: volumetric_deviatoric, fit: constant}}"),
+        "ok.yaml");
+    EXPECT_TRUE(c.model.antilocking[0].constant_fit);
+    EXPECT_NE(c.resolved_yaml.find("fit: constant"), std::string::npos) << c.resolved_yaml;
+    EXPECT_TRUE(LoadSceneFromString(c.resolved_yaml, "again.yaml").model.antilocking[0].constant_fit);
+    const LoadedScene linear = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: node, approach: volumetric_deviatoric, fit: linear}}"),
+        "ok.yaml");
+    EXPECT_FALSE(linear.model.antilocking[0].constant_fit);
+    EXPECT_EQ(linear.resolved_yaml.find("fit:"), std::string::npos) << "written only when constant";
+  }
   ExpectError(WithMaterial(steel + "antilocking: {method: none, stress: true}}"), 7,
               "materials.steel.antilocking.stress", "needs a control volume");
   ExpectError(WithMaterial(steel + "antilocking: {method: cell, stress: 2}}"), 7,
@@ -891,7 +910,7 @@ TEST(SceneParserTest, AntiLockingPerBody) {
   ExpectError(kBase3 + "    antilocking: {method: smoothing, stress: true}\n", 12,
               "bodies[0].antilocking.stress", "not for smoothing");
   ExpectError(kBase3 + "    antilocking: node\n", 12, "bodies[0].antilocking",
-              "expected a map with keys method, approach, strain, stress");
+              "expected a map with keys method, approach, fit, strain, stress");
 }
 
 TEST(SceneParserTest, DampingKeys) {

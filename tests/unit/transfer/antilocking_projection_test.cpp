@@ -255,6 +255,63 @@ TEST_P(FullTensorTest, LinearFieldsAndTheTraceOfEachApproach) {
   EXPECT_GT(moved, 1e-5) << "node-based smoothing of a field with boundaries changes the trace";
 }
 
+// `fit: constant` (the seed's ConstantAntiLocking AS2): on the linear field, cell-based, every
+// filtered component becomes the cell's mass-weighted mean; node-based, a homogeneous deformation
+// stays unchanged and the linear field is smoothed (it is no longer reproduced).
+TEST_P(FullTensorTest, ConstantFitTakesTheControlVolumeMeanOfEveryComponent) {
+  const int dim = std::get<0>(GetParam());
+  const ShapeFunction shape = std::get<1>(GetParam());
+  const auto prepare = [&](AntiLockingMethod method) {
+    Problem s = Make(dim, shape, method, AntiLockingApproach::kVolumetricDeviatoric);
+    s.model.antilocking[0].constant_fit = true;
+    for (size_t p = 0; p < s.L.size(); ++p)
+      s.state.particles.F[p] = ExpSym(Field(dim, s.state.particles.x[p], false));
+    return s;
+  };
+  Problem cell = prepare(AntiLockingMethod::kCell);
+  Project(cell);
+  Real err = 0, moved = 0;
+  for (const auto& [key, members] : Cells(cell)) {
+    const size_t n = Components(dim, Mat3::Zero()).size();
+    std::vector<Real> mean(n, 0.0);
+    Real m = 0;
+    for (size_t p : members) {
+      const auto q = Components(dim, Field(dim, cell.state.particles.x[p], false));
+      m += cell.state.particles.mass[p];
+      for (size_t c = 0; c < n; ++c) mean[c] += cell.state.particles.mass[p] * q[c];
+    }
+    for (size_t p : members) {
+      const auto before = Components(dim, Field(dim, cell.state.particles.x[p], false));
+      const auto after = Components(dim, TrialStrain(cell, p));
+      for (size_t c = 0; c < n; ++c) {
+        err = std::max(err, std::abs(after[c] - mean[c] / m));
+        moved = std::max(moved, std::abs(after[c] - before[c]));
+      }
+    }
+  }
+  EXPECT_LT(err, 1e-10);
+  EXPECT_GT(moved, 1e-4) << "the components vary within a cell, so the constant fit must change them";
+
+  Problem node = prepare(AntiLockingMethod::kNode);
+  Project(node);
+  Real node_moved = 0;
+  for (const Mat3& l : node.L) node_moved = std::max(node_moved, kDt * l.norm());
+  EXPECT_GT(node_moved, 1e-5) << "node-based constant fit smooths a linear field";
+  Problem still = Make(dim, shape, AntiLockingMethod::kNode, AntiLockingApproach::kVolumetricDeviatoric);
+  still.model.antilocking[0].constant_fit = true;
+  const Mat3 F0 = ExpSym(Field(dim, Vec3(0.8, 0.7, dim == 3 ? 0.6 : 0), false));
+  for (size_t p = 0; p < still.L.size(); ++p) {
+    still.state.particles.F[p] = F0;
+    still.L[p] = Mat3::Identity() * (dim == 3 ? 0.3 : 0.0) + Mat3::Constant(0.1);
+    if (dim == 2) still.L[p].row(2).setZero(), still.L[p].col(2).setZero();
+  }
+  const std::vector<Mat3> L0 = still.L;
+  Project(still);
+  err = 0;
+  for (size_t p = 0; p < still.L.size(); ++p) err = std::max(err, (still.L[p] - L0[p]).norm());
+  EXPECT_LT(err, 1e-9 * L0[0].norm()) << "a homogeneous deformation is unchanged";
+}
+
 TEST_P(FullTensorTest, As2IsTheWeightedLeastSquaresFitInEachCell) {
   const int dim = std::get<0>(GetParam());
   const ShapeFunction shape = std::get<1>(GetParam());
