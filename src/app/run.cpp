@@ -427,6 +427,11 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
       writer.AppendForces(state.time, state.step, state.dt, forces);
     }
     if (rigid) writer.AppendRigid(state.time, state.step, state.rigid);
+    if (report.damping_released) {
+      LogInfo(fmt::format("static equilibrium at t = {:.6g} s (force ratio {:.3g}, energy ratio "
+                          "{:.3g}; Anura3D (6.29)-(6.30)): local damping off from the next step",
+                          state.time, report.force_ratio, report.energy_ratio));
+    }
     if (report.removed_last_step > 0)
       Log(LogLevel::kDebug, fmt::format("{} particles left the domain", report.removed_last_step));
     const bool done = state.time >= model.time.end - end_tolerance;

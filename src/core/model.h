@@ -92,8 +92,14 @@ struct MassScaling {
 struct LocalDamping {
   Real alpha = 0;        // local damping factor [-], 0 <= alpha < 1; 0 = off
   Real until = 1e300;    // damping acts while t_n < until [s]; default: the whole run
+  // Release at static equilibrium (Anura3D manual §6.4): damping switches off after the first
+  // step, once the load ramp is complete, at which the force ratio (6.29) and the energy ratio
+  // (6.30) are both below these tolerances (State::damping_released); 0 = the `until` time alone.
+  Real force_ratio = 0;   // tolerance of ||F_ext - F_int|| / ||F_ext|| [-]
+  Real energy_ratio = 0;  // tolerance of KE / W_ext [-]
   // The factor at time t: alpha before `until`, 0 after.
   Real At(Real t) const { return t < until ? alpha : 0; }
+  bool Equilibrium() const { return force_ratio > 0; }
 };
 
 // Artificial bulk viscosity of a material for shocks (von Neumann & Richtmyer 1950, J. Appl.

@@ -29,6 +29,10 @@ struct State {
   std::vector<MaterialGroup> groups;
   int64_t particles_removed = 0;  // particles that left through open domain sides
   Real wall_work = 0;             // cumulative work done on the particles by walls [J]
+  // Local damping's equilibrium rule (LocalDamping::Equilibrium): damping has been switched off,
+  // and the work of gravity on the particles while the rule watched (W_ext of (6.30)) [J].
+  bool damping_released = false;
+  Real external_work = 0;
   Real internal_work = 0;         // cumulative stress work sum_p V sigma : d dt on the particles
                                   // (trapezoid per step; stored + dissipated) [J]
   std::vector<RigidBodyState> rigid;  // dynamic obstacles (ObstacleMotion::body), Bullet-stepped

@@ -386,6 +386,8 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
     WriteInt(f, "particles_removed", s.particles_removed, tmp);
     WriteReal(f, "wall_work", s.wall_work, tmp);
     WriteReal(f, "internal_work", s.internal_work, tmp);
+    WriteReal(f, "external_work", s.external_work, tmp);
+    WriteReal(f, "damping_released", s.damping_released ? 1.0 : 0.0, tmp);
     WriteReal(f, "next_output", c.next_output, tmp);
     WriteReal(f, "next_checkpoint", c.next_checkpoint, tmp);
     {
@@ -512,6 +514,10 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
   // Checkpoints before 2026-12-03 have no internal work: the sum restarts from 0 (energy output
   // only; the motion is unaffected).
   s.internal_work = H5Aexists(f, "internal_work") > 0 ? ReadReal(f, "internal_work", path) : 0;
+  // Local damping's equilibrium rule (2026-12-03; older checkpoints: not released, no work yet).
+  s.external_work = H5Aexists(f, "external_work") > 0 ? ReadReal(f, "external_work", path) : 0;
+  s.damping_released =
+      H5Aexists(f, "damping_released") > 0 && ReadReal(f, "damping_released", path) != 0;
   c.next_output = ReadReal(f, "next_output", path);
   c.next_checkpoint = ReadReal(f, "next_checkpoint", path);
   {

@@ -341,6 +341,10 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   }
   model.damping.alpha = spec.damping.local;
   if (spec.damping.until) model.damping.until = *spec.damping.until;
+  if (spec.damping.equilibrium) {  // Anura3D §6.4
+    model.damping.force_ratio = spec.damping.force_ratio;
+    model.damping.energy_ratio = spec.damping.energy_ratio;
+  }
   model.mass_scaling.factor = spec.mass_scaling.factor;
   if (spec.mass_scaling.until) model.mass_scaling.until = *spec.mass_scaling.until;
   for (const BodySpec& b : spec.bodies) {

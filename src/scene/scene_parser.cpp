@@ -1252,11 +1252,30 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
   if (root["gravity"]) spec.gravity = Vector(root["gravity"], "gravity", "m/s^2");
   if (root["gravity_ramp"]) spec.gravity_ramp = NonNegative(root["gravity_ramp"], "gravity_ramp", "s");
   if (const YAML::Node d = root["damping"]) {
-    // damping: {local: alpha, until: t} (Anura3D manual §6.3.1; docs/scene-reference.md).
-    ExpectMap(d, "damping", {"local", "until"});
+    // damping: {local: alpha, until: t, equilibrium: {force_ratio, energy_ratio}} (Anura3D manual
+    // §6.3.1, §6.4; docs/scene-reference.md).
+    ExpectMap(d, "damping", {"local", "until", "equilibrium"});
     spec.damping.loc = Loc(d, "damping");
     spec.damping.local = Ranged(Need(d, "damping", "local"), "damping.local", "-", 0, true, 1, false);
     if (d["until"]) spec.damping.until = Positive(d["until"], "damping.until", "s");
+    if (const YAML::Node eq = d["equilibrium"]) {
+      ExpectMap(eq, "damping.equilibrium", {"force_ratio", "energy_ratio"});
+      spec.damping.equilibrium = true;
+      if (eq["force_ratio"]) {
+        spec.damping.force_ratio = Positive(eq["force_ratio"], "damping.equilibrium.force_ratio", "-");
+      }
+      if (eq["energy_ratio"]) {
+        spec.damping.energy_ratio =
+            Positive(eq["energy_ratio"], "damping.equilibrium.energy_ratio", "-");
+      }
+      if (spec.damping.local == 0) {
+        Fail(eq, "damping.equilibrium", "the equilibrium rule releases the damping: needs local > 0");
+      }
+      if (spec.gravity.norm() == 0) {
+        Fail(eq, "damping.equilibrium",
+             "the force ratio (6.29) is measured against the gravity load: needs a non-zero gravity");
+      }
+    }
   }
   if (const YAML::Node ms = root["mass_scaling"]) {
     // mass_scaling: {factor: beta, until: t} (Anura3D manual §6.5; docs/scene-reference.md).
@@ -1710,6 +1729,11 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
     e << YAML::Key << "damping" << YAML::Value << YAML::Flow << YAML::BeginMap;
     e << YAML::Key << "local" << YAML::Value << Num(spec.damping.local);
     if (spec.damping.until) e << YAML::Key << "until" << YAML::Value << Num(*spec.damping.until);
+    if (spec.damping.equilibrium) {
+      e << YAML::Key << "equilibrium" << YAML::Value << YAML::BeginMap << YAML::Key
+        << "force_ratio" << YAML::Value << Num(spec.damping.force_ratio) << YAML::Key
+        << "energy_ratio" << YAML::Value << Num(spec.damping.energy_ratio) << YAML::EndMap;
+    }
     e << YAML::EndMap;
   }
   if (spec.mass_scaling.factor > 1) {  // only when on: resolved scenes without it stay the same

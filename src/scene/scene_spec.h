@@ -265,6 +265,9 @@ struct AnalysisSpec {
 struct DampingSpec {
   Real local = 0;              // alpha [-], [0, 1); 0 = off
   std::optional<Real> until;   // [s]; unset = the whole run
+  // `equilibrium: {force_ratio, energy_ratio}`: release at static equilibrium (Anura3D §6.4).
+  bool equilibrium = false;
+  Real force_ratio = 1e-3, energy_ratio = 1e-4;  // tolerances of (6.29), (6.30) [-]
   SourceLoc loc;
 };
 

@@ -57,8 +57,38 @@ void BodyContactStage(const Model& m, const StepContext& c, State&, Workspace& w
   ApplyBodyContact(m, c, w.grid, r.walls, r.body_contact);
 }
 
-void LocalDampingStage(const Model&, const StepContext& c, State&, Workspace& w, StepReport&) {
-  if (c.damping > 0) ApplyLocalDamping(c, w.grid);
+// Local damping (6.22)-(6.23) and, with the equilibrium rule (Anura3D manual §6.4), its release:
+// once the load ramp is complete, the first step whose force ratio F = ||F_ext - F_int|| /
+// ||F_ext|| (6.29) and energy ratio E = KE / W_ext (6.30) are both below the tolerances switches
+// the damping off for the steps after it. KE is that of the particles at the start of the step
+// (v_n); W_ext, the work of the (ramped) gravity on the particles, is summed as dt sum m g . v_n
+// over every step while the rule watches, from the first one.
+void LocalDampingStage(const Model& m, const StepContext& c, State& s, Workspace& w, StepReport& r) {
+  if (c.damping <= 0) return;
+  if (!m.damping.Equilibrium()) {
+    ApplyLocalDamping(c, w.grid);
+    return;
+  }
+  ApplyLocalDamping(c, w.grid, &w.damping);
+  const Particles& P = s.particles;
+  const Vec3 g = c.ramp * m.gravity;  // the weight's acceleration (unscaled by mass scaling)
+  std::array<Real, kReductionChunks> kinetic{}, power{};
+  ParallelChunks(P.size(), [&](size_t chunk, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) {
+      kinetic[chunk] += 0.5 * P.mass[p] * P.v[p].squaredNorm();
+      power[chunk] += P.mass[p] * g.dot(P.v[p]);
+    }
+  });
+  Real ke = 0, pw = 0;
+  for (size_t k = 0; k < kReductionChunks; ++k) ke += kinetic[k], pw += power[k];
+  s.external_work += c.dt * pw;
+  const Real inf = std::numeric_limits<Real>::infinity();
+  r.force_ratio = w.damping.external > 0 ? std::sqrt(w.damping.unbalanced / w.damping.external) : inf;
+  r.energy_ratio = s.external_work > 0 ? ke / s.external_work : inf;
+  if (c.ramp >= 1 && r.force_ratio < m.damping.force_ratio && r.energy_ratio < m.damping.energy_ratio) {
+    s.damping_released = true;
+    r.damping_released = true;
+  }
 }
 
 void SensorsStage(const Model& m, const StepContext& c, State&, Workspace& w, StepReport& r) {

@@ -88,7 +88,9 @@ void Step(const Model& model, const Pipeline& pipeline, State& state, Workspace&
   // With mass scaling the grid's inertia is beta m_i (ParticleToGridStage) while the weight stays
   // m_i g: as an acceleration on the scaled inertia, gravity is g / beta.
   ctx.gravity = ctx.ramp * model.gravity / ctx.mass_scale;
-  ctx.damping = model.damping.At(state.time);  // Anura3D §6.3: alpha, 0 after damping.until
+  // Anura3D §6.3: alpha, 0 after damping.until or once the equilibrium rule released it (§6.4).
+  ctx.damping = state.damping_released ? 0 : model.damping.At(state.time);
+  report.damping_released = false;
   if (!(ctx.dt >= model.time.min_dt) || !std::isfinite(ctx.dt)) {
     report.health = Health{HealthStatus::kTimeStepTooSmall, -1,
                            "time step " + std::to_string(ctx.dt) + " s is below time.min_dt = " +

@@ -23,6 +23,10 @@ struct StepReport {
   std::vector<ObstacleForce> sensors;    // force-sensor sums of the last step (Model order)
   BodyContactReport body_contact;        // MPM-MPM contact of the last step (body contacts only)
   int64_t removed_last_step = 0; // particles removed through open sides in the last step
+  // Local damping's equilibrium rule (LocalDamping::Equilibrium), while it watches: the force
+  // ratio (6.29) and energy ratio (6.30) of the last step, and whether they released the damping.
+  Real force_ratio = 0, energy_ratio = 0;
+  bool damping_released = false;
 };
 
 using StageFn = void (*)(const Model&, const StepContext&, State&, Workspace&, StepReport&);

@@ -23,6 +23,7 @@ struct Workspace {
   BulkViscosityScratch bulk_viscosity;  // q_p between steps: its q, id and dt_bound are saved
                                         // in checkpoints (io/checkpoint.h)
   ContactScratch contact;               // broad phase and partial sums of the obstacle contact
+  DampingBalance damping;               // force-ratio sums of local damping's equilibrium rule
   // Energy guard of EnergyStage (docs/stability.md): set on its first step of a run or restart.
   struct EnergyGuard {
     bool set = false;

@@ -74,7 +74,17 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
 // ctx.damping on the components of v_{n+1} that no wall or obstacle constrained. Reads mass,
 // force, velocity (v_n); writes velocity_new. Pre: UpdateGridVelocity and the obstacle contact
 // ran this step, ctx.damping > 0.
-void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid);
+// With `balance` (the equilibrium rule, Anura3D §6.4), also the squared norms for the force ratio
+// (6.29): `unbalanced` sums (m a_d)^2 = (f_d + m g_d)^2 over the components that no constraint
+// changed (the free degrees of freedom; a prescribed one carries a reaction instead), `external`
+// sums (m g_d)^2 over every component of every node with mass (the gravity load; tractions are
+// part of f and not separated). Per-block partials in `balance->partials`, added in block order:
+// the same for any thread count.
+struct DampingBalance {
+  std::vector<Real> partials;  // scratch, 2 per block
+  Real unbalanced = 0, external = 0;  // [N^2]
+};
+void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid, DampingBalance* balance = nullptr);
 
 // Contact between MPM bodies of the last step (ApplyBodyContact).
 struct BodyContactReport {

@@ -68,6 +68,8 @@ Checkpoint FullCheckpoint(size_t n) {
   s.particles_removed = 42;
   s.wall_work = -std::nextafter(1.5, 2.0);
   s.internal_work = std::nextafter(2.25, 3.0);
+  s.external_work = std::nextafter(4.5, 5.0);
+  s.damping_released = true;
   Particles& P = s.particles;
   P.Resize(n);
   for (size_t p = 0; p < n; ++p) {
@@ -146,6 +148,8 @@ TEST_F(CheckpointTest, RoundTripIsBitwise) {
     EXPECT_EQ(r.state.particles_removed, 42);
     EXPECT_EQ(r.state.wall_work, c.state.wall_work);
     EXPECT_EQ(r.state.internal_work, c.state.internal_work);
+    EXPECT_EQ(r.state.external_work, c.state.external_work);
+    EXPECT_TRUE(r.state.damping_released);
     ASSERT_EQ(r.state.groups.size(), 2u);
     EXPECT_EQ(r.state.groups[1].material, 2);
     EXPECT_EQ(r.state.groups[1].begin, n / 2);

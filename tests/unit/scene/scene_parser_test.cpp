@@ -932,6 +932,30 @@ TEST(SceneParserTest, DampingKeys) {
   EXPECT_EQ(again.model.damping.until, 0.5);
   const LoadedScene always = LoadSceneFromString(kBase3 + "damping: {local: 0.1}\n", "ok.yaml");
   EXPECT_EQ(always.model.damping.At(1e9), 0.1);
+  EXPECT_FALSE(always.model.damping.Equilibrium());
+  EXPECT_EQ(always.resolved_yaml.find("equilibrium"), std::string::npos);
+  // equilibrium: release at static equilibrium (Anura3D §6.4), defaults 1e-3 and 1e-4.
+  const std::string g = "gravity: [0, -9.81, 0]\n";
+  const LoadedScene eq =
+      LoadSceneFromString(kBase3 + g + "damping: {local: 0.7, equilibrium: {}}\n", "ok.yaml");
+  EXPECT_TRUE(eq.model.damping.Equilibrium());
+  EXPECT_EQ(eq.model.damping.force_ratio, 1e-3);
+  EXPECT_EQ(eq.model.damping.energy_ratio, 1e-4);
+  const LoadedScene eq2 = LoadSceneFromString(
+      kBase3 + g + "damping: {local: 0.7, until: 2, equilibrium: {force_ratio: 5e-4, energy_ratio: 1e-6}}\n",
+      "ok.yaml");
+  const LoadedScene eq_again = LoadSceneFromString(eq2.resolved_yaml, "again.yaml");
+  EXPECT_EQ(eq_again.model.damping.force_ratio, 5e-4);
+  EXPECT_EQ(eq_again.model.damping.energy_ratio, 1e-6);
+  EXPECT_EQ(eq_again.model.damping.until, 2);
+  ExpectError(kBase3 + g + "damping: {local: 0.7, equilibrium: {force: 1e-3}}\n", 13,
+              "damping.equilibrium.force", "unknown key 'force'");
+  ExpectError(kBase3 + g + "damping: {local: 0.7, equilibrium: {energy_ratio: -1}}\n", 13,
+              "damping.equilibrium.energy_ratio", "must be > 0");
+  ExpectError(kBase3 + g + "damping: {local: 0, equilibrium: {}}\n", 13, "damping.equilibrium",
+              "needs local > 0");
+  ExpectError(kBase3 + "damping: {local: 0.7, equilibrium: {}}\n", 12, "damping.equilibrium",
+              "needs a non-zero gravity");
 }
 
 TEST(SceneParserTest, MassScalingKeys) {
