@@ -1460,17 +1460,6 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
       }
       spec.body_contacts.push_back(std::move(c));
     }
-    if (spec.damping.local > 0) {
-      // The per-body fields of body_contact.cpp predict their own velocities; damping them
-      // consistently with the common field is not implemented.
-      Fail(root["damping"]["local"], "damping.local",
-           "local damping does not work with body_contact yet (per-body velocity fields)");
-    }
-    if (spec.mass_scaling.factor > 1) {
-      // The per-body fields carry their own masses and momenta; scaling them is not implemented.
-      Fail(root["mass_scaling"]["factor"], "mass_scaling.factor",
-           "mass scaling does not work with body_contact yet (per-body velocity fields)");
-    }
   }
 
   if (root["output"]) {

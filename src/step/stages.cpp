@@ -30,6 +30,13 @@ void ParticleToGridStage(const Model& m, const StepContext& c, State& s, Workspa
       w.grid.mass[i] *= beta;
       w.grid.momentum[i] *= beta;
     });
+    // The per-body fields of body contacts likewise (their forces are forces; the mass moment
+    // scales with the mass, so the contact normals x-bar - x_i are unchanged).
+    ParallelFor(w.grid.field_mass.size(), 4096, [&](size_t i) {
+      w.grid.field_mass[i] *= beta;
+      w.grid.field_momentum[i] *= beta;
+      w.grid.field_mass_moment[i] *= beta;
+    });
   }
 }
 

@@ -43,8 +43,10 @@ Pipeline MakePipeline(const Model& model) {
                                  [](const Wall& w) { return w.kind != WallKind::kOpen; });
   if (model.ghost_nodes != GhostNodes::kConstrain && walls)  // docs/walls.md; timed with the grid update
     p.push_back({Stage::kGridUpdate, WallGhostStage});
-  if (model.field_count > 0) p.push_back({Stage::kBodyContact, BodyContactStage});  // Anura3D §6.2
+  // Local damping acts on the common field, after its constraints; with body contacts the
+  // per-body fields then take its velocity change as they take the walls' (body_contact.cpp).
   if (model.damping.alpha > 0) p.push_back({Stage::kLocalDamping, LocalDampingStage});  // A3D (6.23)
+  if (model.field_count > 0) p.push_back({Stage::kBodyContact, BodyContactStage});  // Anura3D §6.2
   const bool antilocking = AnyAntiLocking(model);
   if (model.scheme == UpdateScheme::kUsl) {
     p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)

@@ -6,8 +6,10 @@
 // common field (their sum) went through the grid update, the walls and the obstacles as in
 // single-field MPM. Here, at every node where two or more fields have mass:
 //   1. each field predicts v_f = v_f,n + dt (f_f / m_f + g) (6.1)-(6.2) and takes the velocity
-//      change the walls and obstacles made to the common field, so that sum_f m_f v_f equals
-//      m v_c, the common (centre-of-mass) velocity after the constraints (6.3);
+//      change the walls, obstacles and local damping made to the common field, so that
+//      sum_f m_f v_f equals m v_c, the common (centre-of-mass) velocity after the constraints
+//      (6.3): the damping force on the node is shared among the fields in proportion to mass
+//      (with mass scaling, P2G scales the fields' masses and momenta as the common field's);
 //   2. the normal is the outward normal of one body of the pair, the first one the scene
 //      lists (the flat or stiff one: a slab, a wall), at the node: from that body's local
 //      centre of mass xbar (m_i,f xbar = sum_{p in f} m_p N_ip x_p) to the node, n = (x_i -
