@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -13,6 +12,7 @@
 
 #include "contact/geometry.h"
 #include "core/parallel.h"
+#include "transfer/shape_functions.h"
 
 namespace surge {
 namespace {
@@ -68,25 +68,6 @@ inline void Constrain(const SurfaceQuery& q, const ObstacleContact& law, const V
 // World position of grid node i.
 inline Vec3 NodePosition(const SparseGrid& grid, size_t i, Real dx) {
   return grid.NodeCoord(i).cast<Real>() * dx;
-}
-
-// Index of grid node `node` (node coordinates), which a particle binned in block `owner` reaches:
-// it lies in that block or one of its upper neighbours. -1 when it lies elsewhere or in a block
-// that is not active; *block receives its block.
-inline int64_t NodeFromOwner(const SparseGrid& grid, size_t owner, const Vec3i& node,
-                             int32_t* block) {
-  const Vec3i local = node - grid.block_origin[owner];
-  int k = 0;
-  for (int d = 0; d < 3; ++d) {
-    if (local[d] < 0 || local[d] >= 2 * kBlockDim) return -1;
-    if (local[d] >= kBlockDim) k |= 1 << d;
-  }
-  const int32_t blk = grid.neighbor[owner][k];
-  if (blk < 0) return -1;
-  *block = blk;
-  const Vec3i l = local - Vec3i((k & 1) ? kBlockDim : 0, (k & 2) ? kBlockDim : 0,
-                                (k & 4) ? kBlockDim : 0);
-  return int64_t(blk) * grid.block_nodes + grid.Local(l.x(), l.y(), l.z());
 }
 
 // Broad phase: the blocks (in block order) whose node box meets [lo, hi] widened by tol.
@@ -245,16 +226,6 @@ void ObstacleGaps(const Model& model, const StepContext& ctx, const Obstacle& ob
                 grid.block_nodes, kInf);
     scratch.candidate[size_t(b)] = 1;
   }
-  // Stencil of a particle along one axis: first node and width (shape_functions.h).
-  const int width = model.shape == ShapeFunction::kLinear ? 2
-                    : model.shape == ShapeFunction::kCubicBspline ? 4 : 3;
-  auto base = [&](Real xi) {
-    switch (model.shape) {
-      case ShapeFunction::kLinear: return int(std::floor(xi));
-      case ShapeFunction::kCubicBspline: return int(std::floor(xi)) - 1;
-      default: return int(std::floor(xi - 0.5));
-    }
-  };
   ParallelFor(nb, 4, [&](size_t b) {
     bool reach = scratch.candidate[b] == 1;  // its particles' stencils lie in b and above
     for (int k = 1; k < 8 && !reach; ++k) {
@@ -268,21 +239,15 @@ void ObstacleGaps(const Model& model, const StepContext& ctx, const Obstacle& ob
       const SurfaceQuery q = QueryObstacle(ob, pose, P.x[p], model.dim, 0, 3 * ctx.dx);
       const Real g = std::max(q.distance - 1.5 * half, Real(0));
       if (!(g < 2 * ctx.dx)) continue;  // a wider gap never binds (|v| dt < h)
-      Vec3i lo = Vec3i::Zero(), n = Vec3i::Ones();
-      for (int a = 0; a < model.dim; ++a) {
-        lo[a] = base(P.x[p][a] * ctx.inv_dx);
-        n[a] = width;
-      }
+      Vec3i lo, n;
+      StencilRange(model.shape, model.dim, P.x[p], ctx.inv_dx, lo, n);
       for (int i = 0; i < n.x(); ++i)
         for (int j = 0; j < n.y(); ++j)
           for (int k = 0; k < n.z(); ++k) {
             int32_t blk = -1;
             const int64_t node = NodeFromOwner(grid, b, lo + Vec3i(i, j, k), &blk);
             if (node < 0 || scratch.candidate[size_t(blk)] != 1) continue;
-            std::atomic_ref<Real> slot(scratch.gap[size_t(node)]);
-            Real cur = slot.load(std::memory_order_relaxed);
-            while (g < cur && !slot.compare_exchange_weak(cur, g, std::memory_order_relaxed)) {
-            }
+            AtomicMin(scratch.gap[size_t(node)], g);
           }
     }
   });

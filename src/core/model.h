@@ -135,6 +135,9 @@ struct BodyContact {
   int normal_body = 0;         // body_a or body_b: the body whose surface gives the normal
   Real friction = 0;           // Coulomb coefficient mu [-]
   bool separable = true;       // false: the bodies never separate (normal velocity bonded)
+  // Speculative gap test (separable pairs): at a node the fields may still approach by the gap
+  // between the two bodies' particles (body_contact.cpp); false: contact wherever both have mass.
+  bool gap_test = true;
   std::string name;            // force-log channel: "<other>_on_<normal body>", the force on the
                                // normal body (listed first in the scene) from the other
 };

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 
 namespace surge {
@@ -31,6 +32,21 @@ void ParallelChunks(size_t n, const F& f) {
     const size_t end = n * (c + 1) / kReductionChunks;
     f(c, begin, end);
   });
+}
+
+// Atomic minimum and maximum of a double slot (compare-exchange loops). A minimum or maximum is
+// the same in any order, so slots filled this way do not depend on the thread count.
+inline void AtomicMin(double& slot, double value) {
+  std::atomic_ref<double> a(slot);
+  double cur = a.load(std::memory_order_relaxed);
+  while (value < cur && !a.compare_exchange_weak(cur, value, std::memory_order_relaxed)) {
+  }
+}
+inline void AtomicMax(double& slot, double value) {
+  std::atomic_ref<double> a(slot);
+  double cur = a.load(std::memory_order_relaxed);
+  while (value > cur && !a.compare_exchange_weak(cur, value, std::memory_order_relaxed)) {
+  }
 }
 
 }  // namespace surge

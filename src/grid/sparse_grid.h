@@ -109,6 +109,25 @@ struct SparseGrid {
   size_t ActiveNodeCount() const;  // nodes with mass > 0
 };
 
+// Index of grid node `node` (node coordinates), which a particle binned in block `owner` reaches:
+// it lies in that block or one of its upper neighbours. -1 when it lies elsewhere or in a block
+// that is not active; *block receives its block.
+inline int64_t NodeFromOwner(const SparseGrid& grid, size_t owner, const Vec3i& node,
+                             int32_t* block) {
+  const Vec3i local = node - grid.block_origin[owner];
+  int k = 0;
+  for (int d = 0; d < 3; ++d) {
+    if (local[d] < 0 || local[d] >= 2 * kBlockDim) return -1;
+    if (local[d] >= kBlockDim) k |= 1 << d;
+  }
+  const int32_t blk = grid.neighbor[owner][k];
+  if (blk < 0) return -1;
+  *block = blk;
+  const Vec3i l = local - Vec3i((k & 1) ? kBlockDim : 0, (k & 2) ? kBlockDim : 0,
+                                (k & 4) ? kBlockDim : 0);
+  return int64_t(blk) * grid.block_nodes + grid.Local(l.x(), l.y(), l.z());
+}
+
 // Builds the topology for the given block requests (serial, deterministic: blocks are numbered
 // in tree order), the neighbour table and the colour lists, and sizes the node arrays (zeroed).
 void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid);

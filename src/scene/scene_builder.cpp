@@ -365,7 +365,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
       const int a = std::min(c.body_index[0], c.body_index[1]);
       const int b = std::max(c.body_index[0], c.body_index[1]);
       model.body_contacts.push_back(BodyContact{a, b, c.body_index[0], c.friction, c.separable,
-                                                c.bodies[1] + "_on_" + c.bodies[0]});
+                                                c.gap_test, c.bodies[1] + "_on_" + c.bodies[0]});
       paired[a] = paired[b] = true;
     }
     int fields = 0;

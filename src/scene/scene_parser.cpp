@@ -1414,7 +1414,7 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
     }
     for (size_t i = 0; i < cs.size(); ++i) {
       const std::string cp = Index("body_contact", i);
-      ExpectMap(cs[i], cp, {"bodies", "friction", "separable"});
+      ExpectMap(cs[i], cp, {"bodies", "friction", "separable", "gap_test"});
       BodyContactSpec c;
       c.loc = Loc(cs[i], cp);
       const YAML::Node names = Need(cs[i], cp, "bodies");
@@ -1446,6 +1446,14 @@ SceneSpec Parser::Parse(const YAML::Node& root) {
       }
       if (cs[i]["friction"]) c.friction = NonNegative(cs[i]["friction"], Child(cp, "friction"), "-");
       if (cs[i]["separable"]) c.separable = Bool(cs[i]["separable"], Child(cp, "separable"));
+      c.gap_test = c.separable;
+      if (const YAML::Node gt = cs[i]["gap_test"]) {
+        c.gap_test = Bool(gt, Child(cp, "gap_test"));
+        if (c.gap_test && !c.separable) {
+          Fail(gt, Child(cp, "gap_test"),
+               "the gap test lets separate bodies approach: it needs separable: true");
+        }
+      }
       // The pair's force-log channel shares one namespace with the other structures.
       const std::string channel = c.bodies[1] + "_on_" + c.bodies[0];
       std::vector<std::string> taken = {"domain"};
@@ -1852,7 +1860,7 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
       e << YAML::Flow << YAML::BeginMap << YAML::Key << "bodies" << YAML::Value << YAML::Flow
         << YAML::BeginSeq << c.bodies[0] << c.bodies[1] << YAML::EndSeq << YAML::Key << "friction"
         << YAML::Value << Num(c.friction) << YAML::Key << "separable" << YAML::Value << c.separable
-        << YAML::EndMap;
+        << YAML::Key << "gap_test" << YAML::Value << c.gap_test << YAML::EndMap;
     }
     e << YAML::EndSeq;
   }

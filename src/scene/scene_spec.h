@@ -241,6 +241,7 @@ struct BodyContactSpec {  // a pair of bodies in frictional contact (core/model.
   std::array<int, 2> body_index{};  // into SceneSpec::bodies
   Real friction = 0;                // [-]
   bool separable = true;
+  bool gap_test = true;             // default: separable
   SourceLoc loc;
 };
 

@@ -59,9 +59,12 @@ void ObstacleContactStage(const Model& m, const StepContext& c, State& s, Worksp
   ApplyObstacleContact(m, c, s.rigid, w.grid, w.contact, &r.obstacles, &s.particles);
 }
 
-void BodyContactStage(const Model& m, const StepContext& c, State&, Workspace& w,
+void BodyContactStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                       StepReport& r) {
-  ApplyBodyContact(m, c, w.grid, r.walls, r.body_contact);
+  const bool gap_test = std::any_of(m.body_contacts.begin(), m.body_contacts.end(),
+                                    [](const BodyContact& bc) { return bc.gap_test; });
+  if (gap_test) ComputeBodyContactGaps(m, c, w.grid, s.particles, w.body_gaps);
+  ApplyBodyContact(m, c, w.grid, r.walls, r.body_contact, gap_test ? &w.body_gaps : nullptr);
 }
 
 // Local damping (6.22)-(6.23) and, with the equilibrium rule (Anura3D manual §6.4), its release:

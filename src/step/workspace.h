@@ -24,6 +24,7 @@ struct Workspace {
                                         // in checkpoints (io/checkpoint.h)
   ContactScratch contact;               // broad phase and partial sums of the obstacle contact
   DampingBalance damping;               // force-ratio sums of local damping's equilibrium rule
+  BodyContactGaps body_gaps;            // gap test between MPM bodies (body contacts only)
   // Energy guard of EnergyStage (docs/stability.md): set on its first step of a run or restart.
   struct EnergyGuard {
     bool set = false;

@@ -26,7 +26,14 @@
 //   3. with dv = v_f - v_c: approaching when dv.n_f > 0 (6.4) (always, for a non-separable
 //      pair): the normal part is removed (6.9)-(6.12) and the tangential part is limited by
 //      Coulomb friction, |dv_t| <= mu |dv.n| (6.8) with (6.14): stick if below, else slip by
-//      the excess; separating fields keep their own velocity (free separation, A.8.4);
+//      the excess; separating fields keep their own velocity (free separation, A.8.4).
+//      [Surge] Gap test (BodyContact::gap_test, separable pairs): the fields share nodes as soon
+//      as their kernels overlap, up to 2 x 1.5 h apart with quadratic B-splines, so without it
+//      bodies stop about two cells short of each other. Where the particles of the two bodies
+//      have not met along n (gap g > 0, ComputeBodyContactGaps), the contact is speculative, as
+//      the obstacles' (contact.cpp): the fields may still close the gap within the step, a
+//      relative approach of g / dt, i.e. dv.n_f up to m_other / (m_f + m_other) g / dt for
+//      field f, and only the approach beyond that is removed (friction on the removed part);
 //   4. the domain walls act on each field's velocity (their extra reaction is logged on the
 //      walls); nodes where only one field has mass take the common velocity unchanged.
 // Pairs of bodies that are not in Model::body_contacts are bonded: they take v_c, as in
@@ -39,6 +46,7 @@
 
 #include "core/check.h"
 #include "core/parallel.h"
+#include "transfer/shape_functions.h"
 #include "transfer/transfer.h"
 #include "transfer/walls.h"
 
@@ -52,6 +60,24 @@ constexpr int kFieldSums = 6 * kFaceCount;
 constexpr int kPairSums = 10;
 constexpr int kPairForce = 0, kPairTorque = 3, kPairNodes = 6, kPairMax = 7, kPairTop = 8,
               kPairBottom = 9;
+
+// The pair's normal at node i (x its position) for field f (step 2): outward of the normal body
+// `master`'s material for that body, into it for the other; the component along a wall's normal
+// dropped on or beyond the wall; zero where it is undefined.
+Vec3 PairNormal(const SparseGrid& grid, size_t i, int master, int f, const Vec3& x,
+                const WallPlane* walls, int wall_count, Real tolerance, Real dx) {
+  const size_t mi = size_t(master) * grid.mass.size() + i;
+  Vec3 n = grid.field_mass_moment[mi] / grid.field_mass[mi];  // xbar - x_i
+  if (master == f) n = -n;
+  // On or beyond a domain wall the body's material is cut off by the wall, which shifts its local
+  // centre of mass along the wall normal; a wall is a symmetry plane of the material (slip), so
+  // that component is dropped.
+  for (int k = 0; k < wall_count; ++k)
+    if (walls[k].sign * (x[walls[k].axis] - walls[k].level) <= tolerance) n[walls[k].axis] = 0;
+  const Real n_norm = n.norm();
+  return n_norm > 1e-9 * dx ? Vec3(n / n_norm) : Vec3::Zero();  // zero: no normal part
+}
+
 }  // namespace
 
 std::vector<int> BodyContactPairTable(const Model& model) {
@@ -65,8 +91,75 @@ std::vector<int> BodyContactPairTable(const Model& model) {
   return table;
 }
 
+void ComputeBodyContactGaps(const Model& model, const StepContext& ctx, const SparseGrid& grid,
+                            const Particles& P, BodyContactGaps& gaps) {
+  const int F = grid.field_count;
+  const size_t nb = grid.block_count(), N = grid.mass.size();
+  const std::vector<int> pair = BodyContactPairTable(model);
+  WallPlane walls[kFaceCount];
+  const int wall_count = ActiveWalls(model, walls);
+  const Real tolerance = 1e-9 * ctx.dx, inf = std::numeric_limits<Real>::infinity();
+  gaps.master.assign(N, -1);
+  gaps.other.assign(N, -1);
+  gaps.normal.resize(N);
+  gaps.front_master.assign(N, -inf);
+  gaps.front_other.assign(N, inf);
+  ParallelFor(nb, 4, [&](size_t b) {
+    for (int l = 0; l < grid.block_nodes; ++l) {
+      const size_t i = b * size_t(grid.block_nodes) + size_t(l);
+      if (!(grid.mass[i] > 0)) continue;
+      int fa = -1, fb = -1;  // the two heaviest fields here (lowest index on a tie)
+      for (int f = 0; f < F; ++f) {
+        const Real mf = grid.field_mass[f * N + i];
+        if (!(mf > 0)) continue;
+        if (fa < 0 || mf > grid.field_mass[fa * N + i]) {
+          fb = fa;
+          fa = f;
+        } else if (fb < 0 || mf > grid.field_mass[fb * N + i]) {
+          fb = f;
+        }
+      }
+      if (fb < 0) continue;
+      const int c = pair[size_t(fa) * F + fb];
+      if (c < 0 || !model.body_contacts[c].gap_test || !model.body_contacts[c].separable) continue;
+      const int master = model.body_field[model.body_contacts[c].normal_body];
+      const Vec3 x = (grid.block_origin[b] + grid.LocalCoord(l)).cast<Real>() * ctx.dx;
+      const Vec3 n = PairNormal(grid, i, master, master, x, walls, wall_count, tolerance, ctx.dx);
+      if (n.isZero()) continue;
+      gaps.master[i] = int8_t(master);
+      gaps.other[i] = int8_t(master == fa ? fb : fa);
+      gaps.normal[i] = n;
+    }
+  });
+  ParallelFor(nb, 4, [&](size_t b) {
+    for (uint32_t k = grid.block_begin[b]; k < grid.block_begin[b + 1]; ++k) {
+      const size_t p = grid.sorted[k];
+      const int f = model.body_field[size_t(P.body[p])];
+      if (f < 0) continue;
+      const Real r = 0.5 * (model.dim == 3 ? std::cbrt(P.volume0[p]) : std::sqrt(P.volume0[p]));
+      Vec3i lo, n;
+      StencilRange(model.shape, model.dim, P.x[p], ctx.inv_dx, lo, n);
+      for (int a = 0; a < n.x(); ++a)
+        for (int c = 0; c < n.y(); ++c)
+          for (int e = 0; e < n.z(); ++e) {
+            const Vec3i node = lo + Vec3i(a, c, e);
+            int32_t blk = -1;
+            const int64_t i = NodeFromOwner(grid, b, node, &blk);
+            if (i < 0 || gaps.master[size_t(i)] < 0) continue;
+            const Real s = (P.x[p] - node.cast<Real>() * ctx.dx).dot(gaps.normal[size_t(i)]);
+            if (gaps.master[size_t(i)] == f) {
+              AtomicMax(gaps.front_master[size_t(i)], s + r);
+            } else if (gaps.other[size_t(i)] == f) {
+              AtomicMin(gaps.front_other[size_t(i)], s - r);
+            }
+          }
+    }
+  });
+}
+
 void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& grid,
-                      WallReport& walls_report, BodyContactReport& report) {
+                      WallReport& walls_report, BodyContactReport& report,
+                      const BodyContactGaps* gaps) {
   const int F = grid.field_count;
   SURGE_CHECK(F > 0 && F <= kMaxVelocityFields,
               "body contact needs 1.." + std::to_string(kMaxVelocityFields) +
@@ -131,23 +224,22 @@ void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& gr
           // from the node away from that body's local centre of mass; into it for the other.
           const BodyContact& bc = model.body_contacts[c];
           const int master = model.body_field[bc.normal_body];
-          const size_t mi = size_t(master) * N + i;
-          Vec3 n = grid.field_mass_moment[mi] / grid.field_mass[mi];  // xbar - x_i
-          if (master == f) n = -n;
-          // On or beyond a domain wall the body's material is cut off by the wall, which shifts
-          // its local centre of mass along the wall normal; a wall is a symmetry plane of the
-          // material (slip), so that component is dropped.
-          for (int k = 0; k < wall_count; ++k)
-            if (walls[k].sign * (x[walls[k].axis] - walls[k].level) <= tolerance) n[walls[k].axis] = 0;
-          const Real n_norm = n.norm();
-          n = n_norm > 1e-9 * ctx.dx ? Vec3(n / n_norm) : Vec3::Zero();  // zero: no normal part
+          const Vec3 n = PairNormal(grid, i, master, f, x, walls, wall_count, tolerance, ctx.dx);
           const Vec3 dv = w - vc;
           const Real dvn = dv.dot(n);                // (6.4): > 0 approaching
-          if (dvn > 0 || !bc.separable) {
+          // Gap test (step 3): the approach the gap still allows this field, relative to v_c.
+          Real allowed = 0;
+          if (gaps && gaps->master[i] >= 0 && (f == gaps->master[i] || f == gaps->other[i]) &&
+              (partner == gaps->master[i] || partner == gaps->other[i])) {
+            const Real mp = grid.field_mass[size_t(partner) * N + i];
+            allowed = mp / (mf + mp) * gaps->Gap(i) / ctx.dt;
+          }
+          if (dvn > allowed || !bc.separable) {
             const Vec3 dvt = dv - dvn * n;           // (6.5)
             const Real dvt_norm = dvt.norm();
-            const Real limit = bc.friction * std::abs(dvn);  // (6.8) with (6.14)
-            v = dvt_norm <= limit ? vc : Vec3(vc + (1 - limit / dvt_norm) * dvt);  // stick : slip
+            const Real limit = bc.friction * std::abs(dvn - allowed);  // (6.8) with (6.14)
+            const Vec3 base = allowed > 0 ? Vec3(vc + allowed * n) : vc;
+            v = dvt_norm <= limit ? base : Vec3(base + (1 - limit / dvt_norm) * dvt);  // stick : slip
           } else {
             v = w;  // separating: free
           }

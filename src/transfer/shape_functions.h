@@ -93,6 +93,27 @@ struct CubicBsplineKernel {
 };
 
 // Weights and gradients of one particle over its stencil: W nodes per axis (1 along z in 2-D).
+// The stencil of a particle at x for the scene's kernel, chosen at run time (for passes outside
+// the templated transfers): first node lo and width n per axis (lo = 0, n = 1 along z in 2-D).
+inline void StencilRange(ShapeFunction shape, int dim, const Vec3& x, Real inv_dx, Vec3i& lo,
+                         Vec3i& n) {
+  lo = Vec3i::Zero();
+  n = Vec3i::Ones();
+  for (int a = 0; a < dim; ++a) {
+    const Real xi = x[a] * inv_dx;
+    switch (shape) {
+      case ShapeFunction::kLinear: lo[a] = LinearKernel::Base(xi), n[a] = LinearKernel::kWidth; break;
+      case ShapeFunction::kGimp: lo[a] = GimpKernel::Base(xi), n[a] = GimpKernel::kWidth; break;
+      case ShapeFunction::kQuadraticBspline:
+        lo[a] = QuadraticBsplineKernel::Base(xi), n[a] = QuadraticBsplineKernel::kWidth;
+        break;
+      case ShapeFunction::kCubicBspline:
+        lo[a] = CubicBsplineKernel::Base(xi), n[a] = CubicBsplineKernel::kWidth;
+        break;
+    }
+  }
+}
+
 template <int kDim, class K>
 struct Stencil {
   static constexpr int W = K::kWidth;

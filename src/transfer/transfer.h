@@ -2,6 +2,7 @@
 // Each reads what its comment says and writes only its outputs.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -102,8 +103,33 @@ struct BodyContactReport {
 // walls to each field. Run after the grid update and the obstacle contact. Reads the field
 // arrays of ParticleToGrid and the common velocity, velocity_new. Writes field_velocity,
 // field_velocity_new, reaction (sensors only); adds the walls' extra reaction to walls_report.
+// With `gaps` (BodyContactGaps of this step), separable pairs with gap_test are speculative
+// where their particles have not met: see body_contact.cpp, step 3.
+struct BodyContactGaps;
 void ApplyBodyContact(const Model& model, const StepContext& ctx, SparseGrid& grid,
-                      WallReport& walls_report, BodyContactReport& report);
+                      WallReport& walls_report, BodyContactReport& report,
+                      const BodyContactGaps* gaps = nullptr);
+
+// The speculative gap test between MPM bodies (BodyContact::gap_test; the obstacles' gap test,
+// contact.cpp ObstacleGaps, between two bodies): at every node where two or more fields have mass
+// and the two heaviest form a pair with the test, the pair's normal n (outward of its normal body
+// `master`, as ApplyBodyContact takes it), and over the particles whose stencil holds the node the
+// front of the master body, max (x_p - x_i).n + r_p, and of the other, min (x_p - x_i).n - r_p
+// (r_p = V0^(1/d) / 2, half the particle spacing). gap = other's front - master's front when
+// positive: the bodies' particles have not met along n there. Max and min are the same in any
+// order: the result does not depend on the thread count. Reads the field arrays of
+// ParticleToGrid and x_n.
+struct BodyContactGaps {
+  std::vector<int8_t> master, other;  // fields of the tested pair at each node; -1: no test
+  std::vector<Vec3> normal;           // n, outward of the master body
+  std::vector<Real> front_master, front_other;  // [m] along n from the node
+  Real Gap(size_t i) const {
+    const Real g = front_other[i] - front_master[i];
+    return master[i] >= 0 && std::isfinite(g) && g > 0 ? g : 0;
+  }
+};
+void ComputeBodyContactGaps(const Model& model, const StepContext& ctx, const SparseGrid& grid,
+                            const Particles& particles, BodyContactGaps& gaps);
 
 // Index into Model::body_contacts of the pair of fields (f, g), [f * field_count + g], or -1.
 std::vector<int> BodyContactPairTable(const Model& model);

@@ -204,11 +204,13 @@ struct Settled {
   Real force_ratio_end = 0;  // logged force on the slab / block weight, mean over the last 0.1 s
   Real max_speed_after = 0;  // largest block speed after the release [m/s]
   Real max_speed_late = 0;   // largest block speed after t = 1.1 s [m/s]
+  Real bottom = 0;           // the block's lowest particle - half a spacing at the end [m]
   long steps = 0;
 };
 
-Settled SettleBlock(const std::string& label, const std::string& extra) {
-  std::string text = InclineScene(0, "body_contact:\n  - {bodies: [slab, block], friction: 0.3}\n" + extra);
+Settled SettleBlock(const std::string& label, const std::string& extra,
+                    const std::string& pair = "friction: 0.3") {
+  std::string text = InclineScene(0, "body_contact:\n  - {bodies: [slab, block], " + pair + "}\n" + extra);
   text.replace(text.find("end: 1.0"), 8, "end: 1.5");
   const std::string region = "max: [0.55, 0.45]";
   text.replace(text.find("min: [0.3, 0.2], " + region), 17 + region.size(),
@@ -231,11 +233,17 @@ Settled SettleBlock(const std::string& label, const std::string& extra) {
     }
   });
   out.force_ratio_end = force / samples / weight;
+  out.bottom = 1e30;
+  for (size_t p = 0; p < scene.state.particles.size(); ++p) {
+    if (scene.state.particles.body[p] == 1) {
+      out.bottom = std::min(out.bottom, scene.state.particles.x[p].y() - 0.5 * 0.05 / 2);
+    }
+  }
   std::printf("block dropped on an MPM slab, %s: released at %.4f s, contact force / weight "
               "%.5f over 1.4-1.5 s, max block speed after the release %.2e m/s and after 1.1 s %.2e m/s, "
-              "%ld steps\n",
+              "block bottom at %.4f m (slab top 0.2 m), %ld steps\n",
               label.c_str(), out.released, out.force_ratio_end, out.max_speed_after,
-              out.max_speed_late, out.steps);
+              out.max_speed_late, out.bottom, out.steps);
   return out;
 }
 
@@ -251,6 +259,21 @@ TEST(BodyContactTest, DampingAndMassScalingSettleABlockOnAnMpmSlab) {
   EXPECT_LT(scaled.steps, 0.7 * damped.steps);  // sqrt(4) = 2x fewer steps over the scaled phase
   const Settled plain = SettleBlock("undamped", "");
   EXPECT_GT(plain.max_speed_late, 10 * damped.max_speed_late) << "undamped, the block still rings";
+}
+
+// The gap test between MPM bodies (BodyContact::gap_test, default for separable pairs): the block
+// dropped 0.15 m comes to rest on the slab's surface (its lowest particle half a spacing above
+// it). Without the test the fields meet as soon as their kernels share a node and the block
+// stops in mid-air, about two cells up (the problem the test fixes).
+TEST(BodyContactTest, GapTestLetsADroppedBlockLandOnTheSlab) {
+  const std::string damping = "damping: {local: 0.7, until: 1.0}\n";
+  const Settled gap = SettleBlock("gap test", damping);
+  const Settled none = SettleBlock("no gap test", damping, "friction: 0.3, gap_test: false");
+  const Real h = 0.05, r = h / 4;
+  EXPECT_NEAR(gap.bottom, 0.2, 0.25 * r);
+  EXPECT_GT(none.bottom, 0.2 + h);
+  EXPECT_NEAR(gap.force_ratio_end, 1.0, 0.01);
+  EXPECT_NEAR(none.force_ratio_end, 1.0, 0.01);
 }
 
 // Two elastic disks (Sulsky et al. 1994 §5, scenes/two_disks_2d.yaml) meeting head-on with

@@ -52,6 +52,7 @@ TEST(BodyContactParserTest, PairedBodiesGetFieldsAndTheRestShareOne) {
   EXPECT_EQ(c.normal_body, 1);  // the first-listed body: block
   EXPECT_EQ(c.friction, 0.4);
   EXPECT_TRUE(c.separable);
+  EXPECT_TRUE(c.gap_test);  // the default for a separable pair
   EXPECT_EQ(s.model.body_field, (std::vector<int>{0, 1, 2}));  // lid shares the rest field
   EXPECT_EQ(s.model.field_count, 3);
 }
@@ -61,6 +62,7 @@ TEST(BodyContactParserTest, NoBodyContactMeansOneField) {
       Scene("  - {bodies: [slab, lid], separable: false}\n  - {bodies: [block, lid]}\n"), "s.yaml");
   EXPECT_EQ(s.model.field_count, 3);  // every body paired: no rest field
   EXPECT_FALSE(s.model.body_contacts[0].separable);
+  EXPECT_FALSE(s.model.body_contacts[0].gap_test);  // a non-separable pair has none
   std::string text = Scene("");
   text.erase(text.find("body_contact:\n"));
   const LoadedScene one = LoadSceneFromString(text, "s.yaml");
@@ -76,6 +78,10 @@ TEST(BodyContactParserTest, ResolvedYamlRereadsToItself) {
   EXPECT_EQ(b.resolved_yaml, a.resolved_yaml);
   EXPECT_EQ(b.model.body_contacts[0].normal_body, 1);
   EXPECT_EQ(b.model.body_contacts[0].friction, 0.25);
+  const LoadedScene off = LoadSceneFromString(
+      Scene("  - {bodies: [block, slab], gap_test: false}\n"), "s.yaml");
+  EXPECT_FALSE(off.model.body_contacts[0].gap_test);
+  EXPECT_FALSE(LoadSceneFromString(off.resolved_yaml, "again.yaml").model.body_contacts[0].gap_test);
 }
 
 TEST(BodyContactParserTest, BadPairsNameFileLineAndKey) {
@@ -89,7 +95,9 @@ TEST(BodyContactParserTest, BadPairsNameFileLineAndKey) {
   ExpectError(Scene("  - {bodies: [slab, block], friction: -0.1}\n"), 14, "body_contact[0].friction",
               "");
   ExpectError(Scene("  - {bodies: [slab, block], mu: 0.1}\n"), 14, "body_contact[0].mu",
-              "unknown key 'mu' (expected one of: bodies, friction, separable)");
+              "unknown key 'mu' (expected one of: bodies, friction, separable, gap_test)");
+  ExpectError(Scene("  - {bodies: [slab, block], separable: false, gap_test: true}\n"), 14,
+              "body_contact[0].gap_test", "needs separable: true");
   ExpectError(Scene("  {bodies: [slab, block]}\n"), 14, "body_contact", "expected a list of body pairs");
   ExpectError(Scene("  - {bodies: [slab, block]}\n", "musl"), 14, "body_contact[0]",
               "needs grid.update: usl");
