@@ -32,7 +32,7 @@ struct alignas(8) ParticleLayout {
 
 // Design: material history lives in Particles (rather than in per-model SoA arrays) so that
 // reordering, compaction and checkpoints need no per-model code: when a run has a plastic model,
-// every particle carries one b^e and kHistorySlots scalars (136 bytes); otherwise neither array is
+// every particle carries one b^e and kHistorySlots scalars (112 bytes); otherwise neither array is
 // allocated (ParticleLayout). The elastic and fluid updates never read or write them.
 struct Particles {
   ParticleLayout layout;  // which optional arrays (C, strain, elastic_b, history, ext_force) are held
@@ -46,8 +46,8 @@ struct Particles {
   std::vector<Mat3> strain;  // accumulated small strain [-]      written by UpdateStress
                              //   (optional: layout.strain, linear_elastic only)
   // Material history (optional: layout.elastic_b / layout.history, plastic models only).
-  std::vector<Mat3> elastic_b;  // elastic left Cauchy-Green b^e = F^e F^eT [-] (Mast 2013 (3.30))
-                                //                                 written by UpdateStress (j2)
+  std::vector<SymMat3> elastic_b;  // elastic left Cauchy-Green b^e = F^e F^eT [-] (Mast 2013
+                                   // (3.30)), symmetric: 6 components  written by UpdateStress
   std::vector<History> history; // model-defined scalars, units per slot (see kHistorySlots)
                                 //                                 written by UpdateStress (j2)
   // --- Constant: set by the scene builder, never written by Step(). ---

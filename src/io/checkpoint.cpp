@@ -408,7 +408,7 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
       WriteDoubles(l, "F", P.F.data(), n, 9, tmp);
       WriteDoubles(l, "stress", P.stress.data(), n, 6, tmp);  // xx yy zz xy yz xz
       if (P.layout.strain) WriteDoubles(l, "strain", P.strain.data(), n, 9, tmp);
-      if (P.layout.elastic_b) WriteDoubles(l, "elastic_b", P.elastic_b.data(), n, 9, tmp);
+      if (P.layout.elastic_b) WriteDoubles(l, "elastic_b", P.elastic_b.data(), n, 6, tmp);  // as stress
       if (P.layout.history) WriteDoubles(l, "history", P.history.data(), n, kHistorySlots, tmp);
       WriteDoubles(l, "mass", P.mass.data(), n, 0, tmp);
       WriteDoubles(l, "volume0", P.volume0.data(), n, 0, tmp);
@@ -536,15 +536,21 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
     };
     read_optional("C", 9, P.layout.affine, P.C);
     ReadArray(l, "F", d, n, 9, P.F, path);
-    if (Shape(l, "stress", path).second == 9) {  // written before 2026-12-03: the full matrix
-      std::vector<Mat3> full;
-      ReadArray(l, "stress", d, n, 9, full, path);
-      P.stress.assign(full.begin(), full.end());
-    } else {
-      ReadArray(l, "stress", d, n, 6, P.stress, path);
-    }
+    // A symmetric tensor array: (n, 6), or the full (n, 9) matrix of checkpoints written before
+    // 2026-12-03 (stress, elastic_b).
+    const auto read_symmetric = [&](const char* name, std::vector<SymMat3>& out) {
+      if (Shape(l, name, path).second == 9) {
+        std::vector<Mat3> full;
+        ReadArray(l, name, d, n, 9, full, path);
+        out.assign(full.begin(), full.end());
+      } else {
+        ReadArray(l, name, d, n, 6, out, path);
+      }
+    };
+    read_symmetric("stress", P.stress);
     read_optional("strain", 9, P.layout.strain, P.strain);
-    read_optional("elastic_b", 9, P.layout.elastic_b, P.elastic_b);
+    P.layout.elastic_b = H5Lexists(l, "elastic_b", H5P_DEFAULT) > 0;
+    if (P.layout.elastic_b) read_symmetric("elastic_b", P.elastic_b);
     read_optional("history", kHistorySlots, P.layout.history, P.history);
     ReadArray(l, "mass", d, n, 0, P.mass, path);
     ReadArray(l, "volume0", d, n, 0, P.volume0, path);

@@ -63,9 +63,9 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const size_t p = g.begin + k;
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
-                       Mat3 stress;
-                       PlasticUpdate(params, f, P.F[p].determinant(), P.elastic_b[p],
-                                     P.history[p], stress);
+                       Mat3 stress, b = P.elastic_b[p];  // b^e stored as its 6 components
+                       PlasticUpdate(params, f, P.F[p].determinant(), b, P.history[p], stress);
+                       P.elastic_b[p] = b;
                        P.stress[p] = stress;
                      });
                    },
@@ -129,7 +129,7 @@ Real StrainEnergyDensity(const Material& material, const Mat3& F, const Mat3& st
                     material.params);
 }
 
-void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_b,
+void InitialHistory(const Material& material, const Mat3& stress, SymMat3& elastic_b,
                     History& history) {
   history = History{};
   elastic_b = Mat3::Identity();

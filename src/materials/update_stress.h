@@ -18,7 +18,7 @@ void UpdateStress(const Model& model, const StepContext& ctx,
 
 // Material history consistent with a prescribed initial Cauchy stress at F = I (a geostatic
 // start): b^e from the elastic compliance for J2, identity otherwise; history slots zero.
-void InitialHistory(const Material& material, const Mat3& stress, Mat3& elastic_b,
+void InitialHistory(const Material& material, const Mat3& stress, SymMat3& elastic_b,
                     History& history);
 
 // The optional particle arrays a run with these materials needs (Particles::layout): C for APIC

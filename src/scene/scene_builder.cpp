@@ -453,7 +453,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   Particles& P = state.particles;
   P.layout = layout;
   P.Resize(static_cast<size_t>(total));
-  Mat3 unused_b;  // InitialHistory's outputs for a layout without b^e or history
+  SymMat3 unused_b;  // InitialHistory's outputs for a layout without b^e or history
   History unused_history;
   size_t next = 0;
   std::vector<std::pair<int, int>> keys;  // (material, anti-locking setting) in layout order

@@ -455,7 +455,7 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
     const size_t p = begin + i;
     const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
     const Mat3 b_ref = mode.increment       ? Mat3::Identity()
-                       : mode.elastoplastic ? P.elastic_b[p]
+                       : mode.elastoplastic ? P.elastic_b[p].matrix()
                                             : Mat3(P.F[p] * P.F[p].transpose());
     s.trial_ok[p] = TrialLogStrain<kDim>(f, b_ref, s.trial_eps[p], s.inv_stretch[p]);
   });

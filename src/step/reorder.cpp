@@ -46,8 +46,8 @@ void ReorderParticlesStage(const Model&, const StepContext&, State& s, Workspace
   static_assert(sizeof(Particles) == kParticlesSize,
                 "a new Particles array must be permuted here too");
   for (auto* a : {&P.x, &P.v, &P.ext_force}) Permute(*a, order);
-  for (auto* a : {&P.C, &P.F, &P.strain, &P.elastic_b}) Permute(*a, order);
-  Permute(P.stress, order);
+  for (auto* a : {&P.C, &P.F, &P.strain}) Permute(*a, order);
+  for (auto* a : {&P.stress, &P.elastic_b}) Permute(*a, order);
   for (auto* a : {&P.mass, &P.volume0}) Permute(*a, order);
   for (auto* a : {&P.material, &P.body}) Permute(*a, order);
   Permute(P.history, order);

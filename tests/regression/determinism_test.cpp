@@ -23,8 +23,8 @@ uint64_t HashState(const State& s) {
   h = Fnv1a(h, P.x.data(), P.x.size() * sizeof(Vec3));
   h = Fnv1a(h, P.v.data(), P.v.size() * sizeof(Vec3));
   h = Fnv1a(h, P.F.data(), P.F.size() * sizeof(Mat3));
-  h = Fnv1a(h, P.stress.data(), P.stress.size() * sizeof(SymMat3));
-  h = Fnv1a(h, P.elastic_b.data(), P.elastic_b.size() * sizeof(Mat3));
+  h = Fnv1a(h, P.stress.data(), P.stress.size() * sizeof(P.stress[0]));
+  h = Fnv1a(h, P.elastic_b.data(), P.elastic_b.size() * sizeof(P.elastic_b[0]));
   h = Fnv1a(h, P.history.data(), P.history.size() * sizeof(P.history[0]));
   h = Fnv1a(h, &s.time, sizeof s.time);
   return h;

@@ -148,7 +148,7 @@ TEST(DruckerPragerTest, ConeFlowChangesVolumeByTheDilationSlope) {
       const Real alpha = pt.particles.history[0][kJ2PlasticStrain];
       const Real volume = pt.particles.history[0][kDpPlasticVolume];
       const Real lnJp = std::log(pt.particles.F[0].determinant()) -
-                        0.5 * std::log(pt.particles.elastic_b[0].determinant());
+                        0.5 * std::log(pt.particles.elastic_b[0].matrix().determinant());
       Mat3 L = Mat3::Zero();
       L(0, 1) = L(1, 0) = 0.5;
       StepMaterialPoint(pt, L, 1e-4);
@@ -159,7 +159,7 @@ TEST(DruckerPragerTest, ConeFlowChangesVolumeByTheDilationSlope) {
       EXPECT_NEAR(dv, 3 * p.dilation_slope * dgamma, 1e-12) << step;
       // The stored volume change is the kinematic one: ln J^p = ln J - tr(eps_e).
       const Real lnJp_new = std::log(pt.particles.F[0].determinant()) -
-                            0.5 * std::log(pt.particles.elastic_b[0].determinant());
+                            0.5 * std::log(pt.particles.elastic_b[0].matrix().determinant());
       EXPECT_NEAR(lnJp_new - lnJp, dv, 1e-9 * dgamma + 1e-14) << step;
     }
     EXPECT_GT(plastic, 200) << "psi " << psi;

@@ -44,7 +44,7 @@ using testing::RandomL;
 // Plastic volumetric strain ln J^p = ln J - tr(eps_e), eps_e = 1/2 ln b^e.
 Real PlasticVolume(const MaterialPoint& pt) {
   return std::log(pt.particles.F[0].determinant()) -
-         0.5 * std::log(pt.particles.elastic_b[0].determinant());
+         0.5 * std::log(pt.particles.elastic_b[0].matrix().determinant());
 }
 
 TEST(ModifiedDruckerPragerTest, ReturnsLandOnTheFrozenConeAndAnglesFollowTheLaws) {

@@ -16,6 +16,7 @@
 #include <iterator>
 #include <limits>
 #include <random>
+#include <utility>
 
 #include "io/results_reader.h"
 #include "io/results_writer.h"
@@ -315,25 +316,36 @@ TEST_F(CheckpointTest, OptionalArraysRoundTripByLayout) {
 // Checkpoints written before 2026-12-03 hold the stress as (N, 9) column-major matrices; they are
 // still read, into the 6 stored components (the file is edited through HDF5, so it is read
 // without its checksum).
-TEST_F(CheckpointTest, NineComponentStressOfOlderCheckpointsIsRead) {
+TEST_F(CheckpointTest, NineComponentStressAndElasticBOfOlderCheckpointsAreRead) {
   const Checkpoint c = FullCheckpoint(5);
   const std::string path = (dir_ / "nine.h5").string();
   WriteCheckpoint(path, c);
-  std::vector<Mat3> full(5);
-  for (size_t p = 0; p < 5; ++p) full[p] = Mat3(c.state.particles.stress[p]) + Mat3::Identity();
-  {
+  std::vector<Mat3> full(5), b(5);
+  for (size_t p = 0; p < 5; ++p) {
+    full[p] = Mat3(c.state.particles.stress[p]) + Mat3::Identity();
+    b[p] = Mat3(c.state.particles.elastic_b[p]) + 2 * Mat3::Identity();  // symmetric, as written
+  }
+  {  // both symmetric arrays as the full matrices that checkpoints before 2026-12-03 held
     const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    H5Ldelete(f, "particles/stress", H5P_DEFAULT);
-    const hsize_t dims[2] = {5, 9};
-    const hid_t space = H5Screate_simple(2, dims, nullptr);
-    const hid_t d = H5Dcreate2(f, "particles/stress", H5T_IEEE_F64LE, space, H5P_DEFAULT,
-                               H5P_DEFAULT, H5P_DEFAULT);
-    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, full.data());
-    H5Dclose(d);
-    H5Sclose(space);
+    for (const auto& [name, data] : {std::pair{"particles/stress", &full}, std::pair{"particles/elastic_b", &b}}) {
+      H5Ldelete(f, name, H5P_DEFAULT);
+      const hsize_t dims[2] = {5, 9};
+      const hid_t space = H5Screate_simple(2, dims, nullptr);
+      const hid_t d =
+          H5Dcreate2(f, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data->data());
+      H5Dclose(d);
+      H5Sclose(space);
+    }
     H5Fclose(f);
   }
   const Checkpoint r = ReadCheckpoint(path, /*verify_checksum=*/false);
+  ASSERT_EQ(r.state.particles.elastic_b.size(), 5u);
+  for (size_t p = 0; p < 5; ++p) {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (!std::isnan(b[p](i, j))) EXPECT_EQ(r.state.particles.elastic_b[p](i, j), b[p](i, j));
+  }
   ASSERT_EQ(r.state.particles.stress.size(), 5u);
   for (size_t p = 0; p < 5; ++p) {
     for (int i = 0; i < 3; ++i)

@@ -174,7 +174,7 @@ TEST(SceneBuilderTest, GeostaticJ2StateReproducesTheStress) {
   const Particles& P = s.state.particles;
   for (size_t p = 0; p < P.size(); ++p) {
     // Hencky elasticity at F = I: tau = sigma = K tr(eps) 1 + 2G dev(eps), eps = 1/2 ln b^e.
-    Eigen::SelfAdjointEigenSolver<Mat3> eig(P.elastic_b[p]);
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(P.elastic_b[p].matrix());
     const Vec3 e = 0.5 * eig.eigenvalues().array().log();
     const Mat3 eps = eig.eigenvectors() * e.asDiagonal() * eig.eigenvectors().transpose();
     const Mat3 tau = 1.0e7 * eps.trace() * Mat3::Identity() + 2 * 5.0e6 * Dev(eps);
