@@ -342,9 +342,13 @@ TEST_F(CheckpointTest, NineComponentStressAndElasticBOfOlderCheckpointsAreRead) 
   const Checkpoint r = ReadCheckpoint(path, /*verify_checksum=*/false);
   ASSERT_EQ(r.state.particles.elastic_b.size(), 5u);
   for (size_t p = 0; p < 5; ++p) {
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (!std::isnan(b[p](i, j))) EXPECT_EQ(r.state.particles.elastic_b[p](i, j), b[p](i, j));
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (!std::isnan(b[p](i, j))) {
+          EXPECT_EQ(r.state.particles.elastic_b[p](i, j), b[p](i, j));
+        }
+      }
+    }
   }
   ASSERT_EQ(r.state.particles.stress.size(), 5u);
   for (size_t p = 0; p < 5; ++p) {
