@@ -141,6 +141,23 @@ std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
           mat.name, v, m.bodies[b].name, mach, c, mat.density * 100.0 * v * v));
   }
   ObstacleWarnings(m, out);
+  // Stress averaging on node supports (method node or hybrid, `stress: true`) projects the total
+  // mean stress over overlapping supports: an elastic cantilever at nu = 0.49 then loses its
+  // oscillation, as with `strain: total` (antilocking_test, docs/antilocking.md).
+  for (const BodyInfo& body : m.bodies) {
+    const Material& mat = m.materials[size_t(body.material)];
+    const bool fluid = std::visit(
+        [](const auto& p) { return kIsFluid<std::decay_t<decltype(p)>>; }, mat.params);
+    if (fluid || body.antilocking < 0 || size_t(body.antilocking) >= m.antilocking.size()) continue;
+    const AntiLocking& al = m.antilocking[size_t(body.antilocking)];
+    if (al.stress && (al.method == AntiLockingMethod::kNode || al.method == AntiLockingMethod::kHybrid))
+      out.push_back(fmt::format(
+          "body '{}' (material '{}'): stress averaging on node supports (antilocking method {}, "
+          "stress: true) smooths the total mean stress of a solid and damps its bending (an "
+          "incompressible cantilever stops oscillating, docs/antilocking.md); use method: cell "
+          "or stress: false",
+          body.name, mat.name, al.method == AntiLockingMethod::kNode ? "node" : "hybrid"));
+  }
   // A geostatic start is the stress under full gravity: ramping gravity up from zero unloads the
   // layer first, which yields towards the passive side and ends near the elastic K0 = nu/(1-nu)
   // instead (measured: -13 % thrust against Jaky, obstacle_mesh_test).

@@ -593,16 +593,11 @@ AntiLockingSpec Parser::ParseAntiLocking(const YAML::Node& al, const std::string
   if (const YAML::Node st = al["stress"]) {
     a.stress = Bool(st, Child(ap, "stress"));
     if (a.stress && *a.method == AntiLockingMethod::kNone) {
-      Fail(st, Child(ap, "stress"), "stress averaging needs a control volume: method node or cell");
+      Fail(st, Child(ap, "stress"), "stress averaging needs a control volume: method node, cell or hybrid");
     }
     if (a.stress && *a.method == AntiLockingMethod::kSmoothing) {
       Fail(st, Child(ap, "stress"),
-           "stress averaging is implemented for method node or cell only, not for smoothing");
-    }
-    if (a.stress && a.approach != AntiLockingApproach::kVolumetric) {
-      Fail(st, Child(ap, "stress"),
-           "stress averaging is implemented for the volumetric approach only (method node or "
-           "cell, approach volumetric)");
+           "stress averaging is implemented for method node, cell or hybrid, not for smoothing");
     }
   }
   return a;

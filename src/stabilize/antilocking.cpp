@@ -408,9 +408,9 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
   bool any = false;
   for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
     const uint32_t p = grid.sorted[k];
-    if (p < begin || p >= end || !s.trial_ok[p]) continue;
+    if (p < begin || p >= end || !s.tensor_ok[p]) continue;
     any = true;
-    const F f = F::Of(s.trial_eps[p]);
+    const F f = F::Of(s.tensor[p]);
     if constexpr (kNode) {
       Stencil<kDim, K> st;
       st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
@@ -436,41 +436,29 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
   if (any) FlushMoments<kDim, K>(grid, blk, buf, s);
 }
 
-// AS2 / AS3CV on cell- or node-based control volumes, or the hybrid (trace from node-based AS1,
-// deviator from cell-based AS2), on the trial strain of one material group; replaces L_p by
-// (f-bar_p - I)/dt (seed Table 4.1 steps 2-4, (4.25)-(4.27), (4.29)-(4.32), (4.33)-(4.34),
-// (4.40)).
-template <int kDim, class K>
-void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
-                       size_t begin, size_t end, const SparseGrid& grid, const Mode& mode,
-                       const AntiLocking& al, AntiLockingScratch& s, std::vector<Mat3>& L) {
+// The full-tensor approximation of one material group's per-particle tensor field s.tensor (the
+// particles with s.tensor_ok): AS2 / AS3CV on cell- or node-based control volumes, or the hybrid
+// (trace from node-based AS1, deviator from cell-based AS2). Hands each particle's approximated
+// tensor to apply(p, tensor) (seed Table 4.1 steps 3 and 6: (4.25)-(4.27), (4.29)-(4.32),
+// (4.33)-(4.35)). In 2-D the out-of-plane normal entry is the particle's own.
+template <int kDim, class K, class Apply>
+void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                   size_t begin, size_t end, const SparseGrid& grid, const AntiLocking& al,
+                   AntiLockingScratch& s, const Apply& apply) {
   using F = Filtered<kDim>;
   constexpr int M = F::kMoments;
-  const size_t n = P.size();
-  s.trial_eps.resize(n);
-  s.inv_stretch.resize(n);
-  s.trial_ok.resize(n);
-  // Step 2: the trial (elastic) strain of every particle of the group.
-  ParallelFor(end - begin, 256, [&](size_t i) {
-    const size_t p = begin + i;
-    const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
-    const Mat3 b_ref = mode.increment       ? Mat3::Identity()
-                       : mode.elastoplastic ? P.elastic_b[p].matrix()
-                                            : Mat3(P.F[p] * P.F[p].transpose());
-    s.trial_ok[p] = TrialLogStrain<kDim>(f, b_ref, s.trial_eps[p], s.inv_stretch[p]);
-  });
-  // Hybrid, volumetric part: node-based AS1 of theta = tr eps (4.29)-(4.32), (4.34)_1.
+  // Hybrid, volumetric part: node-based AS1 of the trace (4.29)-(4.32), (4.34)_1, (4.35)_1.
   const bool hybrid = al.method == AntiLockingMethod::kHybrid;
   if (hybrid) {
-    s.theta_bar.assign(n, std::numeric_limits<Real>::quiet_NaN());
+    s.theta_bar.assign(P.size(), std::numeric_limits<Real>::quiet_NaN());
     const auto theta = [&](size_t p) {
-      return s.trial_ok[p] ? F::Of(s.trial_eps[p]).q[0] : std::numeric_limits<Real>::quiet_NaN();
+      return s.tensor_ok[p] ? F::Of(s.tensor[p]).q[0] : std::numeric_limits<Real>::quiet_NaN();
     };
     const auto keep = [&](size_t p, Real theta_bar) { s.theta_bar[p] = theta_bar; };
     Project<kDim, K, true>(ctx, P, x_n, begin, end, grid, s, theta, keep);
   }
-  // Cell moments (4.25)_1 with H_c = sum S^T S m, or node moments (4.29)_1, colour-phased as
-  // every scatter.
+  // Cell moments (4.25) with H_c = sum S^T S m, or node moments (4.29) with H_i = sum S^T S N m,
+  // colour-phased as every scatter.
   const bool node = al.method == AntiLockingMethod::kNode;
   const bool constant_trace = al.approach == AntiLockingApproach::kConstantVolumetric;
   // `fit: constant` (the seed's ConstantAntiLocking): every component the control volume's
@@ -489,9 +477,9 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
     });
   }
   if (node) {
-    // Node-based: the nodal values eps-hat_i = S(xi_i) alpha_i (4.31)_1, the support's fit at the
+    // Node-based: the nodal values q-hat_i = S(xi_i) alpha_i (4.31), the support's fit at the
     // node itself (xi = 0 in node-centred coordinates); AS3CV takes the trace's weighted mean.
-    // Then eps^h_p = M* sum_i N_ip eps-hat_i (4.32)_1.
+    // Then q^h_p = M* sum_i N_ip q-hat_i (4.32).
     constexpr int Q = F::kLinear + F::kConst;
     s.node_fit.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(Q), 0.0);
     ParallelFor(grid.block_count(), 1, [&](size_t blk) {
@@ -514,7 +502,7 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
       const Vec3i origin = grid.block_origin[blk];
       for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
         const uint32_t p = grid.sorted[k];
-        if (p < begin || p >= end || !s.trial_ok[p]) continue;
+        if (p < begin || p >= end || !s.tensor_ok[p]) continue;
         Stencil<kDim, K> st;
         st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
         const Vec3i lb = st.base - origin;
@@ -529,20 +517,18 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
               SURGE_ASSERT(g >= 0);
               for (int q = 0; q < Q; ++q) sum.q[q] += w * s.node_fit[size_t(g) * Q + size_t(q)];
             }
-        const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
-        const Mat3 f_bar = ProjectedIncrement<kDim>(f, sum.Tensor(s.trial_eps[p]), s.inv_stretch[p]);
-        if (f_bar.allFinite()) L[p] = (f_bar - Mat3::Identity()) / ctx.dt;
+        apply(p, sum.Tensor(s.tensor[p]));
       }
     });
     return;
   }
-  // Steps 3-4: eps^h_p = M* S_p alpha_c (4.27), or for the hybrid M*_vol theta-bar_p +
-  // M*_dev S_p alpha_c (4.34); then f-bar_p and L_p.
+  // q^h_p = M* S_p alpha_c (4.27), or for the hybrid M*_vol theta-bar_p + M*_dev S_p alpha_c
+  // (4.34)-(4.35).
   ParallelFor(grid.block_count(), 1, [&](size_t blk) {
     const Vec3i origin = grid.block_origin[blk];
     for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
       const uint32_t p = grid.sorted[k];
-      if (p < begin || p >= end || !s.trial_ok[p]) continue;
+      if (p < begin || p >= end || !s.tensor_ok[p]) continue;
       Vec3i cell;
       const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
       const Vec3i lc = cell - origin;
@@ -557,11 +543,60 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
       } else if (constant_trace) {
         fit.q[0] = a[1 + kDim + F::kSym] / a[0];  // AS3CV: the trace constant (4.23)
       }
-      const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
-      const Mat3 f_bar =
-          ProjectedIncrement<kDim>(f, fit.Tensor(s.trial_eps[p]), s.inv_stretch[p]);
-      if (f_bar.allFinite()) L[p] = (f_bar - Mat3::Identity()) / ctx.dt;
+      apply(p, fit.Tensor(s.tensor[p]));
     }
+  });
+}
+
+// AS2 / AS3CV / hybrid on the trial strain of one material group (seed Table 4.1 steps 2-4):
+// the trial (elastic) Hencky strain (4.36)-(4.38) is approximated by FitFullTensor, and L_p is
+// replaced by (f-bar_p - I)/dt with f-bar_p b_ref f-bar_p^T = exp(2 eps^h_p) (4.40).
+template <int kDim, class K>
+void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                       size_t begin, size_t end, const SparseGrid& grid, const Mode& mode,
+                       const AntiLocking& al, AntiLockingScratch& s, std::vector<Mat3>& L) {
+  const size_t n = P.size();
+  s.tensor.resize(n);
+  s.inv_stretch.resize(n);
+  s.tensor_ok.resize(n);
+  // Step 2: the trial (elastic) strain of every particle of the group.
+  ParallelFor(end - begin, 256, [&](size_t i) {
+    const size_t p = begin + i;
+    const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
+    const Mat3 b_ref = mode.increment       ? Mat3::Identity()
+                       : mode.elastoplastic ? P.elastic_b[p].matrix()
+                                            : Mat3(P.F[p] * P.F[p].transpose());
+    s.tensor_ok[p] = TrialLogStrain<kDim>(f, b_ref, s.tensor[p], s.inv_stretch[p]);
+  });
+  // Steps 3-4.
+  FitFullTensor<kDim, K>(ctx, P, x_n, begin, end, grid, al, s, [&](size_t p, const Mat3& eps_h) {
+    const Mat3 f = Mat3::Identity() + ctx.dt * L[p];  // (2.18)
+    const Mat3 f_bar = ProjectedIncrement<kDim>(f, eps_h, s.inv_stretch[p]);
+    if (f_bar.allFinite()) L[p] = (f_bar - Mat3::Identity()) / ctx.dt;
+  });
+}
+
+// AS2 / AS3CV / hybrid on the stress of one material group (seed Table 4.1 steps 6-7, (4.25)_2,
+// (4.28), (4.29)_2-(4.32)_2, (4.35)): the specific Kirchhoff stress q_p = tau_p / rho0_p =
+// J_p V0_p sigma_p / m_p is approximated with the strain's filter, control volumes and weights,
+// and sigma_p <- rho0_p q^h_p / J_p (P = 0 for AS2: the whole tensor is replaced). The material's
+// state (b^e, F, history) is not touched, as with the volumetric stress approximation.
+template <int kDim, class K>
+void ProjectFullTensorStress(const StepContext& ctx, Particles& P, const std::vector<Vec3>& x_n,
+                             size_t begin, size_t end, const SparseGrid& grid,
+                             const AntiLocking& al, AntiLockingScratch& s) {
+  const size_t n = P.size();
+  s.tensor.resize(n);
+  s.tensor_ok.resize(n);
+  ParallelFor(end - begin, 1024, [&](size_t i) {
+    const size_t p = begin + i;
+    const Real J = P.F[p].determinant();
+    s.tensor[p] = (J * P.volume0[p] / P.mass[p]) * P.stress[p].matrix();  // tau / rho0 (3.37)
+    s.tensor_ok[p] = J > 0 && s.tensor[p].allFinite();  // else left to CheckState
+  });
+  FitFullTensor<kDim, K>(ctx, P, x_n, begin, end, grid, al, s, [&](size_t p, const Mat3& q_h) {
+    const Mat3 sigma = (P.mass[p] / (P.volume0[p] * P.F[p].determinant())) * q_h;
+    if (sigma.allFinite()) P.stress[p] = sigma;
   });
 }
 
@@ -698,7 +733,7 @@ bool AnyStressAveraging(const Model& model) {
   return false;
 }
 
-void ProjectMeanStress(const Model& model, const StepContext& ctx,
+void ProjectStress(const Model& model, const StepContext& ctx,
                        const std::vector<MaterialGroup>& groups, Particles& particles,
                        const std::vector<Vec3>& x_n, const SparseGrid& grid,
                        AntiLockingScratch& scratch) {
@@ -708,6 +743,12 @@ void ProjectMeanStress(const Model& model, const StepContext& ctx,
     if (g.end == g.begin || size_t(g.AntiLockingIndex()) >= model.antilocking.size()) continue;
     const AntiLocking& a = model.antilocking[size_t(g.AntiLockingIndex())];
     if (a.method == AntiLockingMethod::kNone || !a.stress) continue;
+    if (a.method == AntiLockingMethod::kHybrid || a.approach != AntiLockingApproach::kVolumetric) {
+      DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
+        ProjectFullTensorStress<kDim, K>(ctx, P, x_n, g.begin, g.end, grid, a, scratch);
+      });
+      continue;
+    }
     DispatchProjection(model, a.method, [&]<int kDim, class K, bool kNode>() {
       // The seed projects the specific stress sigma-bar = tau / rho0 (Table 4.1 step 6, (4.25)_2,
       // (4.29)_2 with M = [1 1 1 0 0 0]): q_p = tr(tau_p) / (3 rho0_p), tau = J sigma (3.37),

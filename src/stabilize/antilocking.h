@@ -18,9 +18,10 @@ struct AntiLockingScratch {
   std::vector<Real> weight;    // sum_p w_ip m_p over a control volume [kg]          (4.29), (4.25)
   std::vector<Real> weighted;  // sum_p w_ip m_p theta_p [kg]                        (4.29), (4.25)
   // Full-tensor approaches (AS2, AS3CV, hybrid) only; per particle, then per cell.
-  std::vector<Mat3> trial_eps;    // trial (elastic) Hencky strain 1/2 ln b^tr       (4.36)-(4.38)
+  std::vector<Mat3> tensor;       // the approximated field: the trial (elastic) Hencky
+                                  // strain 1/2 ln b^tr (4.36)-(4.38), or tau / rho0 (step 6)
   std::vector<Mat3> inv_stretch;  // (b^tr)^(-1/2)
-  std::vector<char> trial_ok;     // b^tr positive definite
+  std::vector<char> tensor_ok;    // b^tr positive definite (tau finite)
   std::vector<Real> theta_bar;    // hybrid: node-projected trace                    (4.34)_1
   std::vector<Real> moments;      // cell (or node) moment sums, per grid slot of the cell's lower
                                   // corner (or of the node)
@@ -54,17 +55,20 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
 bool AnyAntiLocking(const Model& model);
 
 // The optional stress approximation of Table 4.1 (steps 6-7) for the anti-locked groups that ask
-// for it (`antilocking: {stress: true}`), on the same control volumes as the strain: the specific
-// mean stress q_p = tr(tau_p) / (3 rho0_p) is projected as theta is (mass weights, (4.25)_2-(4.28),
-// (4.29)_2-(4.32)_2), and each particle's Cauchy stress takes the projected mean,
-// sigma_p += (rho0_p q-bar_p / J_p - tr(sigma_p)/3) 1; the deviator is kept (P = I_dev). The seed
-// found the strain approximation alone sufficient and this step to double the cost (Diss. §7.5,
-// footnote 11). Reads F, mass, volume0, x_n; writes stress of those groups and scratch.
+// for it (`antilocking: {stress: true}`), with the strain's approach, control volumes and mass
+// weights. Volumetric approach (AS1): the specific mean stress q_p = tr(tau_p) / (3 rho0_p) is
+// projected as theta is ((4.25)_2-(4.28), (4.29)_2-(4.32)_2), and each particle's Cauchy stress
+// takes the projected mean, sigma_p += (rho0_p q-bar_p / J_p - tr(sigma_p)/3) 1; the deviator is
+// kept (P = I_dev). Full-tensor approaches (AS2, AS3CV, hybrid (4.35)): the specific stress
+// tau_p / rho0_p is approximated component by component as the trial strain is, and replaces
+// sigma_p whole. The seed found the strain approximation alone sufficient and this step to double
+// the cost (Diss. §7.5, footnote 11). Reads F, mass, volume0, x_n; writes stress of those groups
+// and scratch; b^e, F and the history are not touched.
 // Pre: the stress update of this step has run; grid and binning from x_n.
-void ProjectMeanStress(const Model& model, const StepContext& ctx,
-                       const std::vector<MaterialGroup>& groups, Particles& particles,
-                       const std::vector<Vec3>& x_n, const SparseGrid& grid,
-                       AntiLockingScratch& scratch);
+void ProjectStress(const Model& model, const StepContext& ctx,
+                   const std::vector<MaterialGroup>& groups, Particles& particles,
+                   const std::vector<Vec3>& x_n, const SparseGrid& grid,
+                   AntiLockingScratch& scratch);
 
 // True when any anti-locked material also averages its stress (the pipeline then has the stage).
 bool AnyStressAveraging(const Model& model);

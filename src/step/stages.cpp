@@ -151,7 +151,7 @@ void AntiLockingStage(const Model& m, const StepContext& c, State& s, Workspace&
 // gradient stage swapped it), the positions the grid was binned with.
 void StressAveragingStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                           StepReport&) {
-  ProjectMeanStress(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking);
+  ProjectStress(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking);
 }
 
 // Stress power sum_p J_p V0_p sigma_p : sym(L_p) [W], in fixed chunks (deterministic).

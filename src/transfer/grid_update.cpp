@@ -307,11 +307,13 @@ void MirrorGhostNodes(const Model& model, const StepContext& ctx, SparseGrid& gr
 // constraint changed are damped: where a wall or an obstacle set v_{n+1} (v_{n+1,d} differs from
 // the free prediction v_n + dt (f/m + g)), the degree of freedom is prescribed, as a fixity is
 // in the manual, and its reaction (logged by the wall or obstacle) stays the undamped one.
-void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid, DampingBalance* balance) {
+namespace {
+// kBalance: also sum the force balance of (6.29) per block (only the equilibrium rule reads it).
+template <bool kBalance>
+void DampNodes(const StepContext& ctx, SparseGrid& grid, DampingBalance* balance) {
   const Real alpha = ctx.damping;
-  if (balance) balance->partials.assign(2 * grid.block_count(), 0.0);
   ParallelFor(grid.block_count(), 4, [&](size_t b) {
-    Real unbalanced = 0, external = 0;
+    [[maybe_unused]] Real unbalanced = 0, external = 0;
     for (int l = 0; l < grid.block_nodes; ++l) {
       const size_t i = b * size_t(grid.block_nodes) + size_t(l);
       const Real m = grid.mass[i];
@@ -320,20 +322,26 @@ void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid, DampingBalance*
       const Vec3 a = grid.force[i] / m + ctx.gravity;  // f/m
       const Vec3 vu = v + ctx.dt * (grid.force[i] / m + ctx.gravity);  // as UpdateGridVelocity
       Vec3& vn = grid.velocity_new[i];
-      external += (m * ctx.gravity).squaredNorm();  // ||F_ext||^2 of (6.29)
+      if constexpr (kBalance) external += (m * ctx.gravity).squaredNorm();  // ||F_ext||^2 (6.29)
       for (int d = 0; d < 3; ++d) {
         if (vn[d] != vu[d]) continue;  // constrained by a wall or an obstacle
-        unbalanced += (m * a[d]) * (m * a[d]);  // ||F_ext - F_int||^2 of (6.29), free components
+        if constexpr (kBalance) unbalanced += (m * a[d]) * (m * a[d]);  // ||F_ext - F_int||^2
         const Real sign = v[d] > 0 ? 1 : (v[d] < 0 ? -1 : 0);
         vn[d] = v[d] + ctx.dt * (a[d] - alpha * std::abs(a[d]) * sign);  // (6.22)-(6.23)
       }
     }
-    if (balance) {
+    if constexpr (kBalance) {
       balance->partials[2 * b] = unbalanced;
       balance->partials[2 * b + 1] = external;
     }
   });
-  if (!balance) return;
+}
+}  // namespace
+
+void ApplyLocalDamping(const StepContext& ctx, SparseGrid& grid, DampingBalance* balance) {
+  if (!balance) return DampNodes<false>(ctx, grid, nullptr);
+  balance->partials.assign(2 * grid.block_count(), 0.0);
+  DampNodes<true>(ctx, grid, balance);
   balance->unbalanced = balance->external = 0;
   for (size_t b = 0; b < grid.block_count(); ++b) {  // block order: thread-count independent
     balance->unbalanced += balance->partials[2 * b];

@@ -100,7 +100,8 @@ struct BodyContactReport {
 // Per-body velocity fields (Model::body_contacts; body_contact.cpp has the algorithm and its
 // sources): at nodes where two or more fields have mass, corrects each field's velocity against
 // the common one (no interpenetration, Coulomb friction, free separation), then applies the
-// walls to each field. Run after the grid update and the obstacle contact. Reads the field
+// walls to each field. Run after the grid update, the local damping and the obstacle contact
+// (the damped common velocity is the one the fields are corrected against). Reads the field
 // arrays of ParticleToGrid and the common velocity, velocity_new. Writes field_velocity,
 // field_velocity_new, reaction (sensors only); adds the walls' extra reaction to walls_report.
 // With `gaps` (BodyContactGaps of this step), separable pairs with gap_test are speculative

@@ -81,9 +81,12 @@ TEST(DeterminismTest, AntiLockedScenesAreBitwiseIdenticalForOneAndTwoThreads) {
   EXPECT_EQ(RunWithThreads("column_collapse_2d.yaml", sand, 0.03, 1),
             RunWithThreads("column_collapse_2d.yaml", sand, 0.03, 2));
   // The full-tensor approaches: hybrid (node trace, cell deviator) and AS3CV on the sand's trial
-  // elastic strain; the cell moment scatter must keep the fixed order too.
+  // elastic strain, and the stress approximation on top; the moment scatter must keep the fixed
+  // order too.
   for (const char* al : {"{method: hybrid}", "{method: cell, approach: constant_volumetric}",
-                         "{method: smoothing}", "{method: node, approach: volumetric_deviatoric}"}) {
+                         "{method: smoothing}", "{method: node, approach: volumetric_deviatoric}",
+                         "{method: hybrid, stress: true}",
+                         "{method: node, approach: volumetric_deviatoric, stress: true}"}) {
     std::vector<std::string> full = sand;
     full.back() = std::string("materials.sand.antilocking=") + al;
     EXPECT_EQ(RunWithThreads("column_collapse_2d.yaml", full, 0.03, 1),

@@ -768,8 +768,18 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   ExpectError(WithMaterial(steel + "antilocking: {method: cell, approach: as2}}"), 7,
               "materials.steel.antilocking.approach",
               "expected one of: volumetric, volumetric_deviatoric, constant_volumetric");
-  ExpectError(WithMaterial(steel + "antilocking: {method: hybrid, stress: true}}"), 7,
-              "materials.steel.antilocking.stress", "volumetric approach only");
+  {  // stress averaging with the full-tensor approaches (seed Table 4.1 steps 6-7, (4.35))
+    const LoadedScene hb = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: hybrid, stress: true}}"), "ok.yaml");
+    EXPECT_TRUE(hb.model.antilocking[0].stress);
+    EXPECT_EQ(hb.model.antilocking[0].method, AntiLockingMethod::kHybrid);
+    const LoadedScene as2 = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: cell, approach: volumetric_deviatoric, "
+                             "stress: true}}"),
+        "ok.yaml");
+    EXPECT_TRUE(as2.model.antilocking[0].stress);
+    EXPECT_EQ(as2.model.antilocking[0].approach, AntiLockingApproach::kVolumetricDeviatoric);
+  }
   ExpectError(WithMaterial(steel + "antilocking: {method: smoothing, approach: volumetric_deviatoric}}"),
               7, "materials.steel.antilocking.approach", "smooths the volumetric strain only");
   ExpectError(WithMaterial(steel + "antilocking: {method: smoothing, stress: true}}"), 7,
