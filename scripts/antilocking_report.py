@@ -41,6 +41,12 @@ OPTIONS = [  # label, antilocking map
     ("cell AS2", "{method: cell, approach: volumetric_deviatoric}"),
     ("smoothing", "{method: smoothing}"),
     ("smoothing total", "{method: smoothing, strain: total}"),
+    ("node AS3CV", "{method: node, approach: constant_volumetric}"),
+    ("node AS2 constant", "{method: node, approach: volumetric_deviatoric, fit: constant}"),
+    ("node + stress", "{method: node, stress: true}"),
+    ("cell + stress", "{method: cell, stress: true}"),
+    ("hybrid + stress", "{method: hybrid, stress: true}"),
+    ("cell AS2 + stress", "{method: cell, approach: volumetric_deviatoric, stress: true}"),
 ]
 SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes",
                      "dam_break_barrier_2d.yaml")
