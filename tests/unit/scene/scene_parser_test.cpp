@@ -847,7 +847,7 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
     EXPECT_TRUE(avg.model.antilocking[0].stress);
     EXPECT_TRUE(LoadSceneFromString(avg.resolved_yaml, "again.yaml").model.antilocking[0].stress);
   }
-  // Defaults per class: solids none, fluids node-based on the total strain.
+  // Defaults per class: solids none, the Newtonian fluid node-based on the total strain.
   const LoadedScene solid = LoadSceneFromString(kBase3, "ok.yaml");
   ASSERT_EQ(solid.model.antilocking.size(), 1u);
   EXPECT_EQ(solid.model.antilocking[0].method, AntiLockingMethod::kNone);
@@ -860,6 +860,17 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
                                      "total}"),
             std::string::npos)
       << water.resolved_yaml;
+  // The viscoplastic fluids: node-based on the step's increment (antilocking_test).
+  for (const char* fluid : {"{model: bingham_fluid, density: 1800, bulk_modulus: 1.6e6, "
+                            "viscosity: 5, yield_stress: 200}",
+                            "{model: frictional_fluid, density: 1800, bulk_modulus: 1.6e6, "
+                            "viscosity: 5, friction_angle_deg: 30}"}) {
+    const LoadedScene mud = LoadSceneFromString(WithMaterial(fluid), "ok.yaml");
+    EXPECT_EQ(mud.model.antilocking[0].method, AntiLockingMethod::kNode) << fluid;
+    EXPECT_EQ(mud.model.antilocking[0].strain, AntiLockingStrain::kIncrement) << fluid;
+    EXPECT_EQ(LoadSceneFromString(mud.resolved_yaml, "again.yaml").model.antilocking[0].strain,
+              AntiLockingStrain::kIncrement);
+  }
   const LoadedScene cell = LoadSceneFromString(
       WithMaterial(steel + "antilocking: {method: cell, strain: increment}}"), "ok.yaml");
   EXPECT_EQ(cell.model.antilocking[0].method, AntiLockingMethod::kCell);
