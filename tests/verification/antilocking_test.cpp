@@ -514,9 +514,11 @@ TEST(AntilockingTest, StrainSmoothingUnlocksTheCantileverAndSmoothsTheTankPressu
 // crowding of the bottom 0.15 m band (sum of the particles' initial volumes over the band's
 // volume). Measured 2026-12-01: mirror + node RMS 0.080, crowding 1.40; constrain + node 0.102,
 // 1.43; mirror + none 3.05 (checkerboard), 0.94. The crowding comes from the node-averaged J,
-// not from the wall (docs/antilocking.md, docs/walls.md).
+// not from the wall (docs/antilocking.md, docs/walls.md). Measured 2026-12-03: mirror + node on
+// the increment: no crowding (0.997) but RMS 0.498 (the noise of the impact is never removed).
 TEST(AntilockingTest, DISABLED_BarrierSettledWithMirroredGhostNodes) {
-  for (const std::string run : {"mirror node", "constrain node", "mirror none"}) {
+  for (const std::string run : {"mirror node", "constrain node", "mirror none",
+                                "mirror node, strain: increment"}) {
     constexpr Real kRho = 997.5, kG = 9.81, kFloor = 6.0, kBand = 0.15;
     const std::string ghosts = run.substr(0, run.find(' ')), method = run.substr(run.find(' ') + 1);
     LoadedScene scene = LoadScene(testing::ScenePath("dam_break_barrier_2d.yaml"),
@@ -536,7 +538,7 @@ TEST(AntilockingTest, DISABLED_BarrierSettledWithMirroredGhostNodes) {
     const Real rms = samples.RmsAboutHydrostatic(kRho, kG, h);
     std::printf("barrier damped to 8 s, ghost nodes %s, antilocking %s: RMS %.4f, bottom band "
                 "crowding %.3f\n", ghosts.c_str(), method.c_str(), rms, volume / (kBand * kFloor));
-    if (method != "none") {
+    if (method == "node") {
       EXPECT_LT(rms, 0.2);
     }
   }
