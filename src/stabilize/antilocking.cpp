@@ -52,13 +52,13 @@ Real TrialTheta(const Mat3& f, const Particles& P, size_t p, const Mode& mode) {
 // Seed §3.5 (AS1 as a hydrostatic shift): each principal trial log strain moves by
 // (theta-bar - theta)/dim, i.e. f-bar = exp((theta-bar - theta)/dim) f, so that
 // ln det(f-bar) + ln J_n = theta-bar; the deviatoric part of f is kept (P = I_dev, (4.16)).
-// Replaces L_p by (f-bar - I)/dt. An inverted particle (theta_p not finite) is left to CheckState.
+// theta_p is the particle's TrialTheta of this f, kept from the scatter (AntiLockingScratch::
+// theta). Replaces L_p by (f-bar - I)/dt. An inverted particle (theta_p not finite) is left to
+// CheckState.
 template <int kDim>
-void ShiftVolumetric(const StepContext& ctx, const Particles& P, size_t p, const Mode& mode,
-                     Real theta_bar, Mat3& L) {
-  Mat3 f = Mat3::Identity() + ctx.dt * L;  // (2.18)
-  const Real theta_p = TrialTheta<kDim>(f, P, p, mode);
+void ShiftVolumetric(const StepContext& ctx, Real theta_p, Real theta_bar, Mat3& L) {
   if (!std::isfinite(theta_p)) return;
+  Mat3 f = Mat3::Identity() + ctx.dt * L;  // (2.18)
   const Real scale = std::exp((theta_bar - theta_p) / kDim);
   if constexpr (kDim == 3) {
     f *= scale;
@@ -614,8 +614,9 @@ void SmoothVolumetricStrain(const StepContext& ctx, const Particles& P, const st
   const size_t slots = grid.block_count() * size_t(grid.block_nodes);
   s.weight.assign(slots, 0.0);
   s.weighted.assign(slots, 0.0);
-  const auto theta = [&](size_t p) {
-    return TrialTheta<kDim>(Mat3::Identity() + ctx.dt * L[p], P, p, mode);  // (2.18)
+  s.theta.resize(P.size());
+  const auto theta = [&](size_t p) {  // each particle once (its own block), kept for the shift
+    return s.theta[p] = TrialTheta<kDim>(Mat3::Identity() + ctx.dt * L[p], P, p, mode);  // (2.18)
   };
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
@@ -673,7 +674,7 @@ void SmoothVolumetricStrain(const StepContext& ctx, const Particles& P, const st
             sum += s.node_sum[size_t(n)] / s.node_count[size_t(n)];
           }
       const Real theta_bar = sum / Real(2 * 2 * kz);
-      if (ok && std::isfinite(theta_bar)) ShiftVolumetric<kDim>(ctx, P, p, mode, theta_bar, L[p]);
+      if (ok && std::isfinite(theta_bar)) ShiftVolumetric<kDim>(ctx, s.theta[p], theta_bar, L[p]);
     }
   });
 }
@@ -716,11 +717,13 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
       continue;
     }
     DispatchProjection(model, method, [&]<int kDim, class K, bool kNode>() {
-      const auto theta = [&](size_t p) {
-        return TrialTheta<kDim>(Mat3::Identity() + ctx.dt * L[p], particles, p, mode);  // (2.18)
+      scratch.theta.resize(particles.size());
+      const auto theta = [&](size_t p) {  // each particle once (its own block), kept for the shift
+        return scratch.theta[p] =
+                   TrialTheta<kDim>(Mat3::Identity() + ctx.dt * L[p], particles, p, mode);  // (2.18)
       };
       const auto shift = [&](size_t p, Real theta_bar) {
-        ShiftVolumetric<kDim>(ctx, particles, p, mode, theta_bar, L[p]);
+        ShiftVolumetric<kDim>(ctx, scratch.theta[p], theta_bar, L[p]);
       };
       Project<kDim, K, kNode>(ctx, particles, x_n, g.begin, g.end, grid, scratch, theta, shift);
     });

@@ -17,6 +17,7 @@ namespace surge {
 struct AntiLockingScratch {
   std::vector<Real> weight;    // sum_p w_ip m_p over a control volume [kg]          (4.29), (4.25)
   std::vector<Real> weighted;  // sum_p w_ip m_p theta_p [kg]                        (4.29), (4.25)
+  std::vector<Real> theta;     // volumetric approach: theta_p of each particle, from the scatter
   // Full-tensor approaches (AS2, AS3CV, hybrid) only; per particle, then per cell.
   std::vector<Mat3> tensor;       // the approximated field: the trial (elastic) Hencky
                                   // strain 1/2 ln b^tr (4.36)-(4.38), or tau / rho0 (step 6)

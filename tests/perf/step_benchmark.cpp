@@ -201,6 +201,10 @@ size_t StateBytes(const State& state, const Workspace& w) {
   for (const auto& c : g.colour) b += Bytes(c);
   for (const auto& c : g.chunk_requests) b += Bytes(c);
   b += Bytes(w.velocity_gradient) + Bytes(w.x_new) + Bytes(w.exit_flag) + Bytes(w.reorder);
+  const AntiLockingScratch& a = w.antilocking;  // empty without anti-locking
+  b += Bytes(a.weight) + Bytes(a.weighted) + Bytes(a.theta) + Bytes(a.tensor) +
+       Bytes(a.inv_stretch) + Bytes(a.tensor_ok) + Bytes(a.theta_bar) + Bytes(a.moments) +
+       Bytes(a.node_fit) + Bytes(a.node_sum) + Bytes(a.node_count);
   return b;
 }
 
