@@ -36,11 +36,11 @@ png plot_sweep_default_name "$work/tiny/sweep.png" -- "$py" "$src/scripts/plot_s
 png plot_sweep_histories "$work/h.png" -- "$py" "$src/scripts/plot_sweep.py" "$work/tiny/sweep.csv" --histories --match "w=0.2" --out "$work/h.png"
 
 # The anti-locking comparison (scripts/antilocking_report.py) on a coarse, short dam break with
-# barrier: eight runs, a CSV row each, both PNGs.
+# barrier: fourteen runs (scripts/antilocking_report.py OPTIONS), a CSV row each, both PNGs.
 png antilocking_report "$work/al/plots/antilocking_barrier_pressure.png" -- "$py" "$src/scripts/antilocking_report.py" \
   --surge "$surge" --out "$work/al" --plots "$work/al/plots" --end 0.6 --set grid.cell_size=0.5 \
   --set bodies.0.particles_per_cell=2
-if [ -s "$work/al/plots/antilocking_barrier_force.png" ] && [ "$(wc -l < "$work/al/antilocking_report.csv")" = 9 ]; then
+if [ -s "$work/al/plots/antilocking_barrier_force.png" ] && [ "$(wc -l < "$work/al/antilocking_report.csv")" = 15 ]; then
   ok antilocking_report_table
 else
   bad "antilocking_report_table: $(cat "$work/al/antilocking_report.csv" 2>&1 | head -3)"
