@@ -579,8 +579,9 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
 // AS2 / AS3CV / hybrid on the stress of one material group (seed Table 4.1 steps 6-7, (4.25)_2,
 // (4.28), (4.29)_2-(4.32)_2, (4.35)): the specific Kirchhoff stress q_p = tau_p / rho0_p =
 // J_p V0_p sigma_p / m_p is approximated with the strain's filter, control volumes and weights,
-// and sigma_p <- rho0_p q^h_p / J_p (P = 0 for AS2: the whole tensor is replaced). The material's
-// state (b^e, F, history) is not touched, as with the volumetric stress approximation.
+// and sigma_p <- rho0_p q^h_p / J_p (P = 0 for AS2: the whole tensor is replaced; in 2-D the
+// in-plane block, sigma_33 shifted with its mean). The material's state (b^e, F, history) is not
+// touched, as with the volumetric stress approximation.
 template <int kDim, class K>
 void ProjectFullTensorStress(const StepContext& ctx, Particles& P, const std::vector<Vec3>& x_n,
                              size_t begin, size_t end, const SparseGrid& grid,
@@ -595,7 +596,15 @@ void ProjectFullTensorStress(const StepContext& ctx, Particles& P, const std::ve
     s.tensor_ok[p] = J > 0 && s.tensor[p].allFinite();  // else left to CheckState
   });
   FitFullTensor<kDim, K>(ctx, P, x_n, begin, end, grid, al, s, [&](size_t p, const Mat3& q_h) {
-    const Mat3 sigma = (P.mass[p] / (P.volume0[p] * P.F[p].determinant())) * q_h;
+    Mat3 q = q_h;
+    if constexpr (kDim == 2) {
+      // Plane strain: the in-plane block is approximated; sigma_33 (a reaction, which the 2-D
+      // forces never read) moves with the in-plane mean, so that the particle keeps its own
+      // sigma_33 - (sigma_11 + sigma_22)/2 and a fluid's pressure is smoothed as a whole.
+      const Mat3& own = s.tensor[p];
+      q(2, 2) += 0.5 * ((q_h(0, 0) + q_h(1, 1)) - (own(0, 0) + own(1, 1)));
+    }
+    const Mat3 sigma = (P.mass[p] / (P.volume0[p] * P.F[p].determinant())) * q;
     if (sigma.allFinite()) P.stress[p] = sigma;
   });
 }

@@ -62,7 +62,7 @@ bool AnyAntiLocking(const Model& model);
 // takes the projected mean, sigma_p += (rho0_p q-bar_p / J_p - tr(sigma_p)/3) 1; the deviator is
 // kept (P = I_dev). Full-tensor approaches (AS2, AS3CV, hybrid (4.35)): the specific stress
 // tau_p / rho0_p is approximated component by component as the trial strain is, and replaces
-// sigma_p whole. The seed found the strain approximation alone sufficient and this step to double
+// sigma_p whole (in 2-D the in-plane block; sigma_33 moves with the in-plane mean). The seed found the strain approximation alone sufficient and this step to double
 // the cost (Diss. §7.5, footnote 11). Reads F, mass, volume0, x_n; writes stress of those groups
 // and scratch; b^e, F and the history are not touched.
 // Pre: the stress update of this step has run; grid and binning from x_n.

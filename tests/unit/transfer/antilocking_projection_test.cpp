@@ -357,6 +357,113 @@ TEST_P(FullTensorTest, BitwiseIndependentOfThreadCount) {
   EXPECT_TRUE(out[0] == out[1]);
 }
 
+// The stress step (Table 4.1 steps 6-7, `stress: true`) of the full-tensor approaches projects the
+// specific stress tau/rho0 = J V0 sigma / m with the strain's fit: a homogeneous specific stress and
+// a linear field (AS2, cell; node AS2 one cell inside) are reproduced; AS3CV makes the trace of
+// tau/rho0 the cell's mass-weighted mean and keeps the deviator; the hybrid's trace is the node AS1
+// stress step's and its deviator is kept. Random masses and volumes, a homogeneous F with J != 1.
+TEST_P(FullTensorTest, StressStepProjectsTheSpecificStress) {
+  const int dim = std::get<0>(GetParam());
+  const ShapeFunction shape = std::get<1>(GetParam());
+  Mat3 F0 = Mat3::Identity();
+  F0(0, 0) = 1.05;
+  F0(1, 1) = 0.97;
+  F0(0, 1) = 0.02;
+  const Real J = F0.determinant();
+  // sigma_p from a specific-stress field q(x) [m^2/s^2]: sigma = m q / (V0 J).
+  const auto prepare = [&](AntiLockingMethod method, AntiLockingApproach approach,
+                           const auto& q_of) {
+    Problem s = Make(dim, shape, method, approach);
+    s.model.antilocking[0].stress = true;
+    Particles& P = s.state.particles;
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<Real> u(0.8, 1.2);
+    for (size_t p = 0; p < P.size(); ++p) {
+      P.F[p] = F0;
+      P.volume0[p] *= u(rng);
+      P.stress[p] = Mat3(P.mass[p] / (P.volume0[p] * J) * q_of(P.x[p]));
+    }
+    RebuildGrid(s.model, P, s.grid);
+    AntiLockingScratch scratch;
+    ProjectStress(s.model, s.ctx, s.state.groups, P, P.x, s.grid, scratch);
+    return s;
+  };
+  const auto specific = [&](const Problem& s, size_t p) {
+    const Particles& P = s.state.particles;
+    return Mat3(J * P.volume0[p] / P.mass[p] * P.stress[p].matrix());
+  };
+  const auto linear = [&](const Vec3& x) { return Mat3(1e6 * Field(dim, x, false)); };
+  Mat3 q0 = 1e5 * Mat3::Identity();
+  q0(0, 1) = q0(1, 0) = 3e4;
+  if (dim == 3) q0(1, 2) = q0(2, 1) = -2e4;
+  const auto homogeneous = [&](const Vec3&) { return q0; };
+  for (const auto& [method, approach] : kFullTensor) {
+    if (method == AntiLockingMethod::kSmoothing) continue;  // no stress step for smoothing
+    const Problem s = prepare(method, approach, homogeneous);
+    Real err = 0;
+    for (size_t p = 0; p < s.state.particles.size(); ++p)
+      err = std::max(err, (specific(s, p) - q0).norm());
+    EXPECT_LT(err, 1e-9 * q0.norm()) << int(method) << " " << int(approach);
+  }
+  // AS2 reproduces the linear field, cell-based everywhere, node-based one cell inside.
+  const Problem as2 = prepare(AntiLockingMethod::kCell, AntiLockingApproach::kVolumetricDeviatoric, linear);
+  const Problem nb = prepare(AntiLockingMethod::kNode, AntiLockingApproach::kVolumetricDeviatoric, linear);
+  Real err = 0, inside_err = 0;
+  const Real dx = nb.model.dx;
+  for (size_t p = 0; p < as2.state.particles.size(); ++p) {
+    const Vec3& x = as2.state.particles.x[p];
+    err = std::max(err, (specific(as2, p) - linear(x)).norm());
+    const Vec3 u = x / dx - Vec3(6, 5, dim == 3 ? 4 : 0);
+    bool inside = true;
+    for (int d = 0; d < dim; ++d) inside = inside && u[d] >= 1 && u[d] <= 4;
+    if (inside) inside_err = std::max(inside_err, (specific(nb, p) - linear(x)).norm());
+  }
+  EXPECT_LT(err, 1e-9 * 1e6 * 0.01);
+  EXPECT_LT(inside_err, 1e-9 * 1e6 * 0.01);
+  // AS3CV: the trace of tau/rho0 becomes the cell's mass-weighted mean, the deviator is kept.
+  const Problem as3 = prepare(AntiLockingMethod::kCell, AntiLockingApproach::kConstantVolumetric, linear);
+  Real trace_err = 0, dev_err = 0, moved = 0;
+  for (const auto& [cell, members] : Cells(as3)) {
+    Real m = 0, mq = 0;
+    for (size_t p : members) {
+      m += as3.state.particles.mass[p];
+      mq += as3.state.particles.mass[p] * linear(as3.state.particles.x[p]).trace();
+    }
+    for (size_t p : members) {
+      const auto before = Components(dim, linear(as3.state.particles.x[p]));
+      const auto after = Components(dim, specific(as3, p));
+      trace_err = std::max(trace_err, std::abs(after[0] - mq / m));
+      moved = std::max(moved, std::abs(after[0] - before[0]));
+      for (size_t c = 1; c < before.size(); ++c)
+        dev_err = std::max(dev_err, std::abs(after[c] - before[c]));
+    }
+  }
+  EXPECT_LT(trace_err, 1e-6);  // of a trace of order 1e4
+  EXPECT_LT(dev_err, 1e-6);
+  EXPECT_GT(moved, 10.0) << "the trace varies within a cell, so AS3CV must change it";
+  // Hybrid: the deviator kept; in 3-D the trace of the node AS1 stress step (which projects the
+  // 3-D mean); in 2-D sigma_33 - (sigma_11 + sigma_22)/2 is kept as well.
+  const Problem hyb = prepare(AntiLockingMethod::kHybrid, AntiLockingApproach::kVolumetricDeviatoric, linear);
+  const Problem as1 = prepare(AntiLockingMethod::kNode, AntiLockingApproach::kVolumetric, linear);
+  trace_err = dev_err = moved = 0;
+  Real out_of_plane = 0;
+  for (size_t p = 0; p < hyb.state.particles.size(); ++p) {
+    const Mat3 q_before = linear(hyb.state.particles.x[p]), q_after = specific(hyb, p);
+    const auto before = Components(dim, q_before);
+    const auto after = Components(dim, q_after);
+    if (dim == 3) trace_err = std::max(trace_err, std::abs(after[0] - specific(as1, p).trace()));
+    moved = std::max(moved, std::abs(after[0] - before[0]));
+    for (size_t c = 1; c < before.size(); ++c)
+      dev_err = std::max(dev_err, std::abs(after[c] - before[c]));
+    const auto dev33 = [](const Mat3& q) { return q(2, 2) - 0.5 * (q(0, 0) + q(1, 1)); };
+    if (dim == 2) out_of_plane = std::max(out_of_plane, std::abs(dev33(q_after) - dev33(q_before)));
+  }
+  EXPECT_LT(trace_err, 1e-6);
+  EXPECT_LT(dev_err, 1e-6);
+  EXPECT_LT(out_of_plane, 1e-6);
+  EXPECT_GT(moved, 1.0) << "node-based smoothing of a field with boundaries changes the trace";
+}
+
 // Anura3D's strain smoothing (manual (6.35)-(6.37)) against a direct re-implementation: cell value
 // = mass-weighted mean of ln det f over the cell's particles, node value = mean over the non-empty
 // cells around the node, particle value = mean of its cell's corner nodes; the deviatoric part of
