@@ -58,4 +58,12 @@ Real HenckyEnergy(Real K, Real G, Real J, const Mat3& stress) {
   return tr * tr / (18.0 * K) + Dev(tau).squaredNorm() / (4.0 * G);  // (3.45)
 }
 
+Real HenckyEnergy(Real K, Real G, Real J, const SymMat3& stress) {
+  const Real* v = stress.v;  // tau = J sigma (3.37), Voigt xx yy zz xy yz xz
+  const Real tr = J * (v[0] + v[1] + v[2]), m = tr / 3.0;
+  const Real d0 = J * v[0] - m, d1 = J * v[1] - m, d2 = J * v[2] - m;
+  const Real dev2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * J * J * (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
+  return tr * tr / (18.0 * K) + dev2 / (4.0 * G);  // (3.45)
+}
+
 }  // namespace surge

@@ -44,6 +44,8 @@ Mat3 ElasticBFromStress(Real K, Real G, const Mat3& tau);
 // Stored energy per reference volume [J/m^3]: psi = K/2 (tr eps_e)^2 + G dev eps_e : dev eps_e
 // (3.45), written in tau = J sigma as (tr tau)^2 / (18 K) + |dev tau|^2 / (4 G).
 Real HenckyEnergy(Real K, Real G, Real J, const Mat3& stress);
+// The same from the 6 stored components (the energy record's per-step sum).
+Real HenckyEnergy(Real K, Real G, Real J, const SymMat3& stress);
 
 // exp(2 eps) of a symmetric tensor through its spectral decomposition (Mast 2013 (4.40)).
 Mat3 ExpTwice(const Mat3& eps);

@@ -2,6 +2,7 @@
 #include "materials/update_stress.h"
 
 #include <array>
+#include <type_traits>
 
 #include "core/parallel.h"
 #include "materials/bingham_fluid.h"
@@ -105,28 +106,32 @@ void UpdateStress(const Model& model, const StepContext& ctx,
   }
 }
 
+namespace {
+
+// psi per reference volume [J/m^3] of one model (the energy record, docs/results-format.md).
+template <class Pm>
+Real EnergyDensityOf(const Pm& p, const Mat3& F, const SymMat3& stress, const Mat3& strain) {
+  if constexpr (std::is_same_v<Pm, LinearElasticParams>) {
+    return LinearElasticEnergy(stress.matrix(), strain);
+  } else if constexpr (std::is_same_v<Pm, NeoHookeanParams>) {
+    return NeoHookeanEnergy(p, F);
+  } else if constexpr (std::is_same_v<Pm, NewtonianFluidParams>) {
+    return NewtonianFluidEnergy(p, F.determinant());
+  } else if constexpr (std::is_same_v<Pm, BinghamFluidParams> ||
+                       std::is_same_v<Pm, FrictionalFluidParams>) {
+    return NewtonianFluidEnergy(EquationOfStateOf(p), F.determinant());  // EOS part only
+  } else {  // elastoplastic: Hencky energy of b^e (3.45)
+    return HenckyEnergy(p.bulk_modulus, p.shear_modulus, F.determinant(), stress);
+  }
+}
+
+}  // namespace
+
 Real StrainEnergyDensity(const Material& material, const Mat3& F, const Mat3& stress,
                          const Mat3& strain) {
-  return std::visit(Overloaded{
-                        [&](const LinearElasticParams&) {
-                          return LinearElasticEnergy(stress, strain);
-                        },
-                        [&](const NeoHookeanParams& p) { return NeoHookeanEnergy(p, F); },
-                        [&](const auto& p) {  // elastoplastic: Hencky energy of b^e (3.45)
-                          return HenckyEnergy(p.bulk_modulus, p.shear_modulus, F.determinant(),
-                                              stress);
-                        },
-                        [&](const NewtonianFluidParams& p) {
-                          return NewtonianFluidEnergy(p, F.determinant());
-                        },
-                        [&](const BinghamFluidParams& p) {  // EOS part only
-                          return NewtonianFluidEnergy(EquationOfStateOf(p), F.determinant());
-                        },
-                        [&](const FrictionalFluidParams& p) {  // EOS part only
-                          return NewtonianFluidEnergy(EquationOfStateOf(p), F.determinant());
-                        },
-                    },
-                    material.params);
+  return std::visit(
+      [&](const auto& p) { return EnergyDensityOf(p, F, SymMat3(stress), strain); },
+      material.params);
 }
 
 void InitialHistory(const Material& material, const Mat3& stress, SymMat3& elastic_b,
@@ -173,13 +178,18 @@ Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,
   for (const MaterialGroup& g : groups) {
     const Material& mat = model.materials[g.material];
     std::array<Real, kReductionChunks> partial{};
-    ParallelChunks(g.end - g.begin, [&](size_t c, size_t b, size_t e) {
-      Real sum = 0;
-      for (size_t p = g.begin + b; p < g.begin + e; ++p)
-        sum += StrainEnergyDensity(mat, P.F[p], P.stress[p],
-                                   P.strain.empty() ? kNoStrain : P.strain[p]) * P.volume0[p];
-      partial[c] = sum;
-    });
+    std::visit(  // once per group, not per particle
+        [&](const auto& params) {
+          ParallelChunks(g.end - g.begin, [&](size_t c, size_t b, size_t e) {
+            Real sum = 0;
+            for (size_t p = g.begin + b; p < g.begin + e; ++p)
+              sum += EnergyDensityOf(params, P.F[p], P.stress[p],
+                                     P.strain.empty() ? kNoStrain : P.strain[p]) *
+                     P.volume0[p];
+            partial[c] = sum;
+          });
+        },
+        mat.params);
     for (Real s : partial) total += s;
   }
   return total;
