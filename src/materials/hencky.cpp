@@ -8,7 +8,17 @@
 namespace surge {
 
 HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_b) {
-  const Mat3 b_trial = Sym(f * elastic_b * f.transpose());  // (3.35)
+  // b^e_tr = f b^e_n f^T (3.35): with b^e_n symmetric the result is, so only its 6 distinct
+  // entries are formed (rows of f b^e_n dotted with rows of f).
+  const Mat3 fb = f * elastic_b;
+  const Vec3 f0 = f.row(0).transpose(), f1 = f.row(1).transpose(), f2 = f.row(2).transpose();
+  const Vec3 a0 = fb.row(0).transpose(), a1 = fb.row(1).transpose();
+  const Real b00 = a0.dot(f0), b01 = a0.dot(f1), b02 = a0.dot(f2);
+  const Real b11 = a1.dot(f1), b12 = a1.dot(f2), b22 = fb.row(2).transpose().dot(f2);
+  Mat3 b_trial;
+  b_trial << b00, b01, b02,  //
+      b01, b11, b12,         //
+      b02, b12, b22;
   HenckyTrial t;
   t.b = b_trial;
   Vec3 b_principal;

@@ -51,8 +51,19 @@ Real HenckyEnergy(Real K, Real G, Real J, const SymMat3& stress);
 Mat3 ExpTwice(const Mat3& eps);
 
 // Principal values -> tensor in the trial frame: Q diag(v) Q^T.
+// Symmetric by construction: the 6 distinct entries sum_k Q_ik v_k Q_jk, mirrored (18
+// multiplications against the 36 of the general product).
 inline Mat3 FromPrincipal(const Mat3& Q, const Vec3& v) {
-  return Q * v.asDiagonal() * Q.transpose();
+  const Vec3 r0 = Q.row(0).transpose().cwiseProduct(v), r1 = Q.row(1).transpose().cwiseProduct(v);
+  const Vec3 q0 = Q.row(0).transpose(), q1 = Q.row(1).transpose(), q2 = Q.row(2).transpose();
+  const Real m00 = r0.dot(q0), m01 = r0.dot(q1), m02 = r0.dot(q2);
+  const Real m11 = r1.dot(q1), m12 = r1.dot(q2);
+  const Real m22 = (Q.row(2).transpose().cwiseProduct(v)).dot(q2);
+  Mat3 m;
+  m << m00, m01, m02,  //
+      m01, m11, m12,   //
+      m02, m12, m22;
+  return m;
 }
 
 }  // namespace surge

@@ -159,8 +159,15 @@ static Real StressPower(const Particles& P, const std::vector<Mat3>& L) {
   std::array<Real, kReductionChunks> partial{};
   ParallelChunks(P.size(), [&](size_t c, size_t b, size_t e) {
     Real sum = 0;
-    for (size_t p = b; p < e; ++p)
-      sum += P.F[p].determinant() * P.volume0[p] * P.stress[p].matrix().cwiseProduct(Sym(L[p])).sum();
+    for (size_t p = b; p < e; ++p) {
+      // sigma : sym(L) from the 6 stored components (Voigt xx yy zz xy yz xz).
+      const Real* t = P.stress[p].v;
+      const Mat3& l = L[p];
+      const Real power = t[0] * l(0, 0) + t[1] * l(1, 1) + t[2] * l(2, 2) +
+                         t[3] * (l(0, 1) + l(1, 0)) + t[4] * (l(1, 2) + l(2, 1)) +
+                         t[5] * (l(0, 2) + l(2, 0));
+      sum += P.F[p].determinant() * P.volume0[p] * power;
+    }
     partial[c] = sum;
   });
   Real total = 0;
@@ -269,23 +276,35 @@ void DomainExitStage(const Model& m, const StepContext&, State& s, Workspace& w,
                      StepReport& r) {
   Particles& P = s.particles;
   const size_t n = P.size();
-  w.exit_flag.assign(n, 0);
+  w.exit_flag.resize(n);
+  // The box and which of its sides are open, hoisted out of the particle loop.
+  const int dim = m.dim;
+  Real lo[3], hi[3];
+  bool open_lo[3], open_hi[3];
+  for (int d = 0; d < dim; ++d) {
+    lo[d] = m.domain_min[d], hi[d] = m.domain_max[d];
+    open_lo[d] = m.walls[2 * d].kind == WallKind::kOpen;
+    open_hi[d] = m.walls[2 * d + 1].kind == WallKind::kOpen;
+  }
   std::array<uint8_t, kReductionChunks> any{};
   ParallelChunks(n, [&](size_t chunk, size_t b, size_t e) {
+    uint8_t any_here = 0;
     for (size_t p = b; p < e; ++p) {
-      for (int d = 0; d < m.dim; ++d) {
-        const Real lo = m.domain_min[d], hi = m.domain_max[d];
+      uint8_t exits = 0;
+      for (int d = 0; d < dim; ++d) {
         Real& xd = P.x[p][d];
-        if (xd < lo) {
-          if (m.walls[2 * d].kind == WallKind::kOpen) w.exit_flag[p] = 1;
-          else xd = lo;
-        } else if (xd > hi) {
-          if (m.walls[2 * d + 1].kind == WallKind::kOpen) w.exit_flag[p] = 1;
-          else xd = hi;
+        if (xd < lo[d]) {
+          if (open_lo[d]) exits = 1;
+          else xd = lo[d];
+        } else if (xd > hi[d]) {
+          if (open_hi[d]) exits = 1;
+          else xd = hi[d];
         }
       }
-      any[chunk] |= w.exit_flag[p];
+      w.exit_flag[p] = exits;
+      any_here |= exits;
     }
+    any[chunk] = any_here;
   });
   r.removed_last_step = 0;
   if (std::find(any.begin(), any.end(), 1) == any.end()) return;
@@ -465,6 +484,13 @@ void CheckStateStage(const Model& m, const StepContext& ctx, State& s, Workspace
   std::array<size_t, kReductionChunks> bad{};
   ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
     for (size_t p = b; p < e; ++p) {
+      // Fast path: a sum of finite numbers is finite unless it overflows, and any NaN or Inf
+      // makes it non-finite, so a finite sum with det F > 0 is a healthy particle; otherwise
+      // the exact tests below decide (an overflowing sum of finite values passes them).
+      const Real* t = P.stress[p].v;
+      const Real sum = P.v[p].sum() + P.x[p].sum() + P.F[p].sum() + t[0] + t[1] + t[2] + t[3] +
+                       t[4] + t[5];
+      if (std::isfinite(sum) && P.F[p].determinant() > 0) continue;
       int field = kFieldOk;
       if (!P.v[p].allFinite()) field = kFieldV;
       else if (!P.x[p].allFinite()) field = kFieldX;
