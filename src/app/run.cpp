@@ -268,6 +268,12 @@ RunSummary RunScene(LoadedScene& scene, const RunOptions& options) {
     missing(needed.elastic_b, held.elastic_b, "elastic_b");
     missing(needed.history, held.history, "history");
     missing(needed.ext_force, held.ext_force, "ext_force");
+    if (needed.history && held.history_slots < needed.history_slots) {
+      throw RunRefused("checkpoint '" + options.restart + "' has " +
+                       std::to_string(held.history_slots) + " history slots per particle, " +
+                       "fewer than the " + std::to_string(needed.history_slots) +
+                       " this scene's materials use");
+    }
     state = std::move(resume.state);
     resume.state = State{};
   } else {

@@ -1,6 +1,7 @@
 // Particle storage: structure of arrays (STYLE H.4). Index p is the same particle in every array.
 // SI units, tension positive (Mast 2013 convention).
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -18,6 +19,54 @@ inline constexpr int kHistorySlots = 8;
 inline constexpr int kPlasticStrainSlot = 0;
 using History = std::array<Real, kHistorySlots>;
 
+// Per-particle history scalars stored with a run-wide stride: the most slots any material of the
+// run uses (ParticleLayout::history_slots), so a smooth-cap Drucker-Prager run stores 3 scalars per
+// particle, not kHistorySlots (performance issue: bytes per particle). Row p is
+// [p * stride, (p + 1) * stride); the models read and write a full History copy of it
+// (UpdateStress), whose slots at and above the stride they leave at zero.
+class HistoryArray {
+ public:
+  Real* operator[](size_t p) { return data_.data() + p * size_t(stride_); }
+  const Real* operator[](size_t p) const { return data_.data() + p * size_t(stride_); }
+  size_t size() const { return stride_ > 0 ? data_.size() / size_t(stride_) : 0; }
+  int stride() const { return stride_; }
+  size_t capacity() const { return data_.capacity(); }  // values allocated (memory accounting)
+  Real* data() { return data_.data(); }
+  const Real* data() const { return data_.data(); }
+  // n rows of `stride` zeros (stride 0: empty); rows kept where both sizes have them.
+  void Resize(size_t n, int stride) {
+    if (stride != stride_) {
+      std::vector<Real> next(n * size_t(stride), 0.0);
+      const size_t rows = std::min(n, size());
+      const int common = std::min(stride, stride_);
+      for (size_t p = 0; p < rows; ++p)
+        for (int k = 0; k < common; ++k) next[p * size_t(stride) + size_t(k)] = (*this)[p][k];
+      data_.swap(next);
+      stride_ = stride;
+    } else {
+      data_.resize(n * size_t(stride), 0.0);
+    }
+  }
+  // The row as a full History (slots at and above the stride are zero), and back.
+  History Get(size_t p) const {
+    History h{};
+    for (int k = 0; k < stride_; ++k) h[size_t(k)] = (*this)[p][k];
+    return h;
+  }
+  void Set(size_t p, const History& h) {
+    for (int k = 0; k < stride_; ++k) (*this)[p][k] = h[size_t(k)];
+  }
+  void CopyRow(size_t to, size_t from) {
+    for (int k = 0; k < stride_; ++k) (*this)[to][k] = (*this)[from][k];
+  }
+  // Exchanges the rows with `rows` (size() * stride() values): the reorder stage's permuted copy.
+  void Swap(std::vector<Real>& rows) { data_.swap(rows); }
+
+ private:
+  std::vector<Real> data_;
+  int stride_ = kHistorySlots;
+};
+
 // Which of the optional particle arrays a run stores. An array a run does not use stays empty
 // (size 0) in every operation, so it costs no memory (performance issue: bytes per particle).
 // The scene builder derives the layout from the materials and tractions (ParticleLayoutFor); the
@@ -28,12 +77,16 @@ struct alignas(8) ParticleLayout {
   bool elastic_b = true;  // b^e: the elastoplastic (Hencky) models
   bool history = true;    // history slots: the plastic models and the yield-stress fluids
   bool ext_force = true;  // particle tractions
+  // History scalars per particle when `history` is set: the largest slot count of the run's
+  // models (HistorySlotsFor), at most kHistorySlots.
+  int history_slots = kHistorySlots;
 };
 
 // Design: material history lives in Particles (rather than in per-model SoA arrays) so that
 // reordering, compaction and checkpoints need no per-model code: when a run has a plastic model,
-// every particle carries one b^e and kHistorySlots scalars (112 bytes); otherwise neither array is
-// allocated (ParticleLayout). The elastic and fluid updates never read or write them.
+// every particle carries one b^e (48 bytes) and the run's history slots (8 bytes each: 3 for the
+// smooth-cap Drucker-Prager, 8 for the traditional one); otherwise neither array is allocated
+// (ParticleLayout). The elastic and Newtonian fluid updates never read or write them.
 struct Particles {
   ParticleLayout layout;  // which optional arrays (C, strain, elastic_b, history, ext_force) are held
   // --- State: advanced by Step(), saved in checkpoints. ---
@@ -48,8 +101,8 @@ struct Particles {
   // Material history (optional: layout.elastic_b / layout.history, plastic models only).
   std::vector<SymMat3> elastic_b;  // elastic left Cauchy-Green b^e = F^e F^eT [-] (Mast 2013
                                    // (3.30)), symmetric: 6 components  written by UpdateStress
-  std::vector<History> history; // model-defined scalars, units per slot (see kHistorySlots)
-                                //                                 written by UpdateStress (j2)
+  HistoryArray history;  // model-defined scalars, units per slot (see kHistorySlots), stride
+                         // layout.history_slots                written by UpdateStress
   // --- Constant: set by the scene builder, never written by Step(). ---
   std::vector<Real> mass;         // [kg]
   std::vector<Real> volume0;      // reference volume [m^3]
@@ -70,7 +123,7 @@ struct Particles {
     stress.resize(n);
     strain.resize(layout.strain ? n : 0);
     elastic_b.resize(layout.elastic_b ? n : 0, Mat3::Identity());
-    history.resize(layout.history ? n : 0, History{});
+    history.Resize(layout.history ? n : 0, layout.history ? layout.history_slots : 0);
     mass.resize(n);
     volume0.resize(n);
     ext_force.resize(layout.ext_force ? n : 0);
@@ -88,7 +141,7 @@ struct Particles {
     stress[to] = stress[from];
     if (layout.strain) strain[to] = strain[from];
     if (layout.elastic_b) elastic_b[to] = elastic_b[from];
-    if (layout.history) history[to] = history[from];
+    if (layout.history) history.CopyRow(to, from);
     mass[to] = mass[from];
     volume0[to] = volume0[from];
     if (layout.ext_force) ext_force[to] = ext_force[from];
@@ -101,7 +154,8 @@ struct Particles {
 // Particles is the layout and these 14 arrays: checkpoint.cpp and reorder.cpp handle each one, and
 // assert this so that a new array is added there too.
 inline constexpr size_t kParticleArrays = 14;
-inline constexpr size_t kParticlesSize =
-    sizeof(ParticleLayout) + kParticleArrays * sizeof(std::vector<Real>);
+inline constexpr size_t kParticlesSize = sizeof(ParticleLayout) +
+                                         (kParticleArrays - 1) * sizeof(std::vector<Real>) +
+                                         sizeof(HistoryArray);
 
 }  // namespace surge

@@ -287,9 +287,11 @@ int64_t ReadInt(hid_t loc, const char* name, const std::string& path) {
 
 // A rows x cols dataset (cols = 0: 1-D) into `out` (resized to rows elements of T, each
 // `cols` (or 1) values of mem_type). Throws when the shape is not rows x cols.
-template <typename T>
-void ReadArray(hid_t loc, const char* name, hid_t mem_type, size_t rows, size_t cols,
-               std::vector<T>& out, const std::string& path) {
+// Reads dataset `name` of shape (rows, cols) (cols 0: (rows)) into `out`, which holds
+// rows * max(cols, 1) elements of mem_type; `resize` sizes it once the shape is checked.
+template <typename Resize>
+void ReadRows(hid_t loc, const char* name, hid_t mem_type, size_t rows, size_t cols,
+              const Resize& resize, const std::string& path) {
   Handle ds(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose);
   Require(ds.ok(), std::string("open ") + name, path);
   Handle space(H5Dget_space(ds.get()), H5Sclose);
@@ -306,11 +308,18 @@ void ReadArray(hid_t loc, const char* name, hid_t mem_type, size_t rows, size_t 
     throw IoError("checkpoint '" + path + "': " + name + " claims " + std::to_string(rows) +
                   " rows, more than the file stores for it");
   }
-  out.resize(rows);
+  void* out = resize();
   if (rows > 0) {
-    Require(H5Dread(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) >= 0,
+    Require(H5Dread(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) >= 0,
             std::string("read ") + name, path);
   }
+}
+
+template <typename T>
+void ReadArray(hid_t loc, const char* name, hid_t mem_type, size_t rows, size_t cols,
+               std::vector<T>& out, const std::string& path) {
+  ReadRows(loc, name, mem_type, rows, cols, [&]() -> void* { out.resize(rows); return out.data(); },
+           path);
 }
 
 // Rows and columns of a dataset (columns 0 unless its rank is 2); any rank fits, ReadArray
@@ -409,7 +418,8 @@ void WriteCheckpoint(const std::string& path, const Checkpoint& c) {
       WriteDoubles(l, "stress", P.stress.data(), n, 6, tmp);  // xx yy zz xy yz xz
       if (P.layout.strain) WriteDoubles(l, "strain", P.strain.data(), n, 9, tmp);
       if (P.layout.elastic_b) WriteDoubles(l, "elastic_b", P.elastic_b.data(), n, 6, tmp);  // as stress
-      if (P.layout.history) WriteDoubles(l, "history", P.history.data(), n, kHistorySlots, tmp);
+      if (P.layout.history)  // (n, layout.history_slots)
+        WriteDoubles(l, "history", P.history.data(), n, size_t(P.history.stride()), tmp);
       WriteDoubles(l, "mass", P.mass.data(), n, 0, tmp);
       WriteDoubles(l, "volume0", P.volume0.data(), n, 0, tmp);
       if (P.layout.ext_force) WriteDoubles(l, "ext_force", P.ext_force.data(), n, 3, tmp);
@@ -551,7 +561,20 @@ Checkpoint ReadCheckpoint(const std::string& path, bool verify_checksum) {
     read_optional("strain", 9, P.layout.strain, P.strain);
     P.layout.elastic_b = H5Lexists(l, "elastic_b", H5P_DEFAULT) > 0;
     if (P.layout.elastic_b) read_symmetric("elastic_b", P.elastic_b);
-    read_optional("history", kHistorySlots, P.layout.history, P.history);
+    // History: (n, slots), 1 <= slots <= kHistorySlots (before 2026-12-03 always kHistorySlots).
+    P.layout.history = H5Lexists(l, "history", H5P_DEFAULT) > 0;
+    if (P.layout.history) {
+      const size_t slots = Shape(l, "history", path).second;
+      if (slots < 1 || slots > size_t(kHistorySlots)) {
+        throw IoError("checkpoint '" + path + "': history has " + std::to_string(slots) +
+                      " columns (expected 1 to " + std::to_string(kHistorySlots) + ")");
+      }
+      P.layout.history_slots = int(slots);
+      ReadRows(l, "history", d, n, slots, [&]() -> void* {
+        P.history.Resize(n, int(slots));
+        return P.history.data();
+      }, path);
+    }
     ReadArray(l, "mass", d, n, 0, P.mass, path);
     ReadArray(l, "volume0", d, n, 0, P.volume0, path);
     read_optional("ext_force", 3, P.layout.ext_force, P.ext_force);

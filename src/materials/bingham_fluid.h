@@ -24,6 +24,7 @@ namespace surge {
 //                          sum dt sqrt(2/3 d':d') over the steps with mu_eff < mu_max [-]
 // (the von Mises measure of j2.h; it shows where the material has flowed, not creep).
 inline constexpr int kFluidYieldedStrain = kPlasticStrainSlot;
+inline constexpr int kFluidHistorySlots = 1;  // slots used (Bingham and frictional fluids)
 
 // The equation of state of a viscoplastic fluid, as a Newtonian fluid without viscosity, so the
 // pressure and stored energy reuse FluidMeanStress and NewtonianFluidEnergy.

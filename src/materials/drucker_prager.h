@@ -14,6 +14,7 @@ namespace surge {
 //   [1 .. 6] back stress beta (Kirchhoff, deviatoric), xx yy zz xy yz xz [Pa]
 //   [7]      plastic volumetric strain sum tr d eps^p, dilation positive [-]
 inline constexpr int kDpPlasticVolume = 7;
+inline constexpr int kDpHistorySlots = 8;  // slots used
 
 void PlasticUpdate(const DruckerPragerParams& params, const Mat3& f, Real J, Mat3& elastic_b,
                    History& history, Mat3& stress);

@@ -13,6 +13,7 @@ namespace surge {
 //                                components xx yy zz xy yz xz
 inline constexpr int kJ2PlasticStrain = kPlasticStrainSlot;
 inline constexpr int kJ2BackStress = 1;
+inline constexpr int kJ2HistorySlots = 7;  // slots used: plastic strain and 6 back stress
 
 // One stress update. Reads the incremental deformation gradient f = I + dt L, J = det F_{n+1},
 // b^e_n and the history; writes b^e_{n+1}, the history and the Cauchy stress sigma_{n+1}.

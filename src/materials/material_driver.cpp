@@ -21,7 +21,9 @@ MaterialPoint MakeMaterialPoint(const Material& material, const Mat3& initial_st
   P.F[0].setIdentity();
   P.stress[0] = initial_stress;
   P.strain[0].setZero();
-  InitialHistory(material, initial_stress, P.elastic_b[0], P.history[0]);
+  History history;
+  InitialHistory(material, initial_stress, P.elastic_b[0], history);
+  P.history.Set(0, history);
   P.volume0[0] = 1.0;
   P.mass[0] = material.density;
   P.ext_force[0].setZero();

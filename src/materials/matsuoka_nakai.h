@@ -28,6 +28,7 @@ inline constexpr int kMnFrictionAngle = 2;
 inline constexpr int kMnCriticalAngle = 3;
 inline constexpr int kMnDilationAngle = 4;
 inline constexpr int kMnVolumetricPlastic = 5;
+inline constexpr int kMnHistorySlots = 6;  // slots used
 
 // kappa = (sin^2 phi - 9) / (sin^2 phi - 1) (3.121), (3.124); phi in degrees,
 // |phi| < 90.

@@ -20,6 +20,7 @@ inline constexpr int kMdpLambda = kPlasticStrainSlot;
 inline constexpr int kMdpFriction = 1;
 inline constexpr int kMdpCritical = 2;
 inline constexpr int kMdpDilation = 3;
+inline constexpr int kMdpHistorySlots = 4;  // slots used
 
 void PlasticUpdate(const ModifiedDruckerPragerParams& params, const Mat3& f, Real J,
                    Mat3& elastic_b, History& history, Mat3& stress);

@@ -22,6 +22,7 @@ namespace surge {
 inline constexpr int kMcPlasticStrain = kPlasticStrainSlot;
 inline constexpr int kMcVolumetricPlastic = 1;
 inline constexpr int kMcReturnRegion = 2;
+inline constexpr int kMcHistorySlots = 3;  // slots used
 
 // Where a return lands (principal stresses sorted tau_1 >= tau_2 >= tau_3, tension positive).
 enum class McRegion {

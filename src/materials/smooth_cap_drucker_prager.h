@@ -18,6 +18,7 @@ namespace surge {
 inline constexpr int kScdpPlasticStrain = kPlasticStrainSlot;
 inline constexpr int kScdpPlasticVolume = 1;
 inline constexpr int kScdpRegion = 2;
+inline constexpr int kScdpHistorySlots = 3;  // slots used
 
 void PlasticUpdate(const SmoothCapDruckerPragerParams& params, const Mat3& f, Real J,
                    Mat3& elastic_b, History& history, Mat3& stress);

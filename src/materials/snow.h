@@ -17,6 +17,7 @@ namespace surge {
 inline constexpr int kSnowPlasticStrain = kPlasticStrainSlot;
 inline constexpr int kSnowVolumetricPlastic = 1;
 inline constexpr int kSnowConsolidation = 2;
+inline constexpr int kSnowHistorySlots = 3;  // slots used
 
 // Hardening law p0(alpha) = K sinh(xi max(-alpha, 0)) [Pa] (Gaume et al. 2018, Methods).
 Real SnowConsolidationPressure(const SnowParams& params, Real alpha);

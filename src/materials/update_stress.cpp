@@ -1,6 +1,7 @@
 // Stress update dispatch: one std::visit per material group (STYLE H.4).
 #include "materials/update_stress.h"
 
+#include <algorithm>
 #include <array>
 #include <type_traits>
 
@@ -65,7 +66,9 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
                        Mat3 stress, b = P.elastic_b[p];  // b^e stored as its 6 components
-                       PlasticUpdate(params, f, P.F[p].determinant(), b, P.history[p], stress);
+                       History h = P.history.Get(p);     // the run's slots, the rest zero
+                       PlasticUpdate(params, f, P.F[p].determinant(), b, h, stress);
+                       P.history.Set(p, h);
                        P.elastic_b[p] = b;
                        P.stress[p] = stress;
                      });
@@ -85,8 +88,10 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
                        Mat3 stress;
+                       History h = P.history.Get(p);
                        BinghamFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p], dt,
-                                          P.history[p], stress);  // A3D (7.37)
+                                          h, stress);  // A3D (7.37)
+                       P.history.Set(p, h);
                        P.stress[p] = stress;
                      });
                    },
@@ -96,8 +101,10 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
                        P.F[p] = f * P.F[p];
                        Mat3 stress;
+                       History h = P.history.Get(p);
                        FrictionalFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p],
-                                             dt, P.history[p], stress);  // A3D (7.38)
+                                             dt, h, stress);  // A3D (7.38)
+                       P.history.Set(p, h);
                        P.stress[p] = stress;
                      });
                    },
@@ -152,19 +159,42 @@ void InitialHistory(const Material& material, const Mat3& stress, SymMat3& elast
       material.params);
 }
 
+int HistorySlotsOf(const MaterialParams& params) {
+  return std::visit(
+      [](const auto& p) {
+        using P = std::decay_t<decltype(p)>;
+        if constexpr (std::is_same_v<P, J2Params>) return kJ2HistorySlots;
+        else if constexpr (std::is_same_v<P, DruckerPragerParams>) return kDpHistorySlots;
+        else if constexpr (std::is_same_v<P, SmoothCapDruckerPragerParams>) return kScdpHistorySlots;
+        else if constexpr (std::is_same_v<P, ModifiedDruckerPragerParams>) return kMdpHistorySlots;
+        else if constexpr (std::is_same_v<P, MatsuokaNakaiParams>) return kMnHistorySlots;
+        else if constexpr (std::is_same_v<P, MohrCoulombParams> || std::is_same_v<P, TrescaParams>)
+          return kMcHistorySlots;
+        else if constexpr (std::is_same_v<P, SnowParams>) return kSnowHistorySlots;
+        else if constexpr (std::is_same_v<P, BinghamFluidParams> ||
+                           std::is_same_v<P, FrictionalFluidParams>)
+          return kFluidHistorySlots;
+        else {
+          static_assert(!kIsElastoplastic<P>, "an elastoplastic model must declare its history slots");
+          return 0;
+        }
+      },
+      params);
+}
+
 ParticleLayout ParticleLayoutFor(const Model& model, bool tractions) {
-  ParticleLayout layout{model.transfer == TransferScheme::kApic, false, false, false, tractions};
+  ParticleLayout layout{model.transfer == TransferScheme::kApic, false, false, false, tractions, 0};
   for (const Material& m : model.materials) {
     std::visit(
         [&](const auto& p) {
           using P = std::decay_t<decltype(p)>;
           layout.strain |= std::is_same_v<P, LinearElasticParams>;  // (small-strain Hooke)
           layout.elastic_b |= kIsElastoplastic<P>;                 // b^e, Table 3.4
-          layout.history |= kIsElastoplastic<P> || std::is_same_v<P, BinghamFluidParams> ||
-                            std::is_same_v<P, FrictionalFluidParams>;
         },
         m.params);
+    layout.history_slots = std::max(layout.history_slots, HistorySlotsOf(m.params));
   }
+  layout.history = layout.history_slots > 0;
   return layout;
 }
 

@@ -26,6 +26,9 @@ void InitialHistory(const Material& material, const Mat3& stress, SymMat3& elast
 // the yield-stress fluids, ext_force when a body has tractions.
 ParticleLayout ParticleLayoutFor(const Model& model, bool tractions);
 
+// History slots a model reads and writes (Particles::history); 0 for models without history.
+int HistorySlotsOf(const MaterialParams& params);
+
 // Stored elastic energy sum psi V0 [J] (per metre of thickness in 2-D), summed in fixed chunks.
 Real StrainEnergy(const Model& model, const std::vector<MaterialGroup>& groups,
                   const Particles& particles);

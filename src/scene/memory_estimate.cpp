@@ -48,7 +48,7 @@ double BytesPerParticle(const ParticleLayout& layout) {
   if (layout.affine) b += Elem<decltype(P::C)>();
   if (layout.strain) b += Elem<decltype(P::strain)>();
   if (layout.elastic_b) b += Elem<decltype(P::elastic_b)>();
-  if (layout.history) b += Elem<decltype(P::history)>();
+  if (layout.history) b += double(layout.history_slots) * sizeof(Real);
   if (layout.ext_force) b += Elem<decltype(P::ext_force)>();
   // Workspace per-particle scratch.
   using W = Workspace;

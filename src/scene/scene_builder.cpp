@@ -453,8 +453,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   Particles& P = state.particles;
   P.layout = layout;
   P.Resize(static_cast<size_t>(total));
-  SymMat3 unused_b;  // InitialHistory's outputs for a layout without b^e or history
-  History unused_history;
+  SymMat3 unused_b;  // InitialHistory's output for a layout without b^e
   size_t next = 0;
   std::vector<std::pair<int, int>> keys;  // (material, anti-locking setting) in layout order
   for (const BodyInfo& b : model.bodies) keys.emplace_back(b.material, b.antilocking);
@@ -472,9 +471,10 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
         P.F[next] = Mat3::Identity();
         P.stress[next] = s.stress[k];
         if (P.layout.strain) P.strain[next] = Mat3::Zero();
+        History history;
         InitialHistory(model.materials[size_t(m)], s.stress[k],
-                       P.layout.elastic_b ? P.elastic_b[next] : unused_b,
-                       P.layout.history ? P.history[next] : unused_history);
+                       P.layout.elastic_b ? P.elastic_b[next] : unused_b, history);
+        if (P.layout.history) P.history.Set(next, history);
         P.mass[next] = s.mass;
         P.volume0[next] = s.volume0;
         if (P.layout.ext_force) P.ext_force[next] = s.ext_force[k];

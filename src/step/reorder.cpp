@@ -19,6 +19,16 @@ void Permute(std::vector<T>& a, const std::vector<uint32_t>& order) {
   a.swap(permuted);
 }
 
+void Permute(HistoryArray& a, const std::vector<uint32_t>& order) {
+  const size_t stride = size_t(a.stride());
+  std::vector<Real> permuted(a.size() * stride);
+  ParallelFor(a.size(), 4096, [&](size_t i) {
+    const Real* from = a[order[i]];
+    for (size_t k = 0; k < stride; ++k) permuted[i * stride + k] = from[k];
+  });
+  a.Swap(permuted);
+}
+
 }  // namespace
 
 void ReorderParticlesStage(const Model&, const StepContext&, State& s, Workspace& w, StepReport&) {

@@ -185,6 +185,8 @@ size_t Bytes(const std::vector<T>& v) {
   return v.capacity() * sizeof(T);
 }
 
+size_t Bytes(const HistoryArray& h) { return h.capacity() * sizeof(Real); }
+
 // Bytes held by the particle arrays and the step's scratch (grid included).
 size_t StateBytes(const State& state, const Workspace& w) {
   const Particles& P = state.particles;

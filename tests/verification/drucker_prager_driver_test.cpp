@@ -63,7 +63,7 @@ TEST(DruckerPragerTest, ReturnsEndOnTheConeOrAtTheApex) {
       if (step % 1000 >= 985) L += 50.0 * Mat3::Identity();  // stretch through the apex
       if (step % 1000 < 40) L -= 2.0 * Mat3::Identity();     // and back into compression
       StepMaterialPoint(pt, L, 1e-4);
-      const History& h = pt.particles.history[0];
+      const History h = pt.particles.history.Get(0);
       const Mat3 tau = Tau(pt);
       const Real scale = std::max(tau.norm(), 1e3);
       if (h[kJ2PlasticStrain] == alpha && h[kDpPlasticVolume] == volume) continue;  // elastic
@@ -129,12 +129,12 @@ TEST(DruckerPragerTest, RigidRotationIsObjective) {
   std::uniform_real_distribution<Real> u(-1.0, 1.0);
   for (int r = 0; r < 10; ++r) {
     const Mat3 sigma0 = pt.particles.stress[0].matrix();
-    const Mat3 beta0 = J2BackStressOf(pt.particles.history[0]);
+    const Mat3 beta0 = J2BackStressOf(pt.particles.history.Get(0));
     const Mat3 R = Eigen::AngleAxis<Real>(3 * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized())
                        .toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / 1e-4, 1e-4);
     EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(), 1e-10 * sigma0.norm());
-    EXPECT_LE((J2BackStressOf(pt.particles.history[0]) - R * beta0 * R.transpose()).norm(),
+    EXPECT_LE((J2BackStressOf(pt.particles.history.Get(0)) - R * beta0 * R.transpose()).norm(),
               1e-10 * sigma0.norm());
   }
 }
@@ -232,8 +232,8 @@ TEST(DruckerPragerTest, SceneBlockStandsWithCohesionAndCollapsesWithout) {
         const Mat3 tau = P.F[i].determinant() * P.stress[i].matrix();
         const Real scale = std::max(tau.norm(), 1e3);
         // Admissible: inside the cone (3.84) and below the cutoff (3.93).
-        worst = std::max(worst, DruckerPragerYield(p, tau, P.history[i]) / scale);
-        worst = std::max(worst, (tau.trace() - DruckerPragerApex(p, P.history[i])) / scale);
+        worst = std::max(worst, DruckerPragerYield(p, tau, P.history.Get(i)) / scale);
+        worst = std::max(worst, (tau.trace() - DruckerPragerApex(p, P.history.Get(i))) / scale);
       }
       kinetic_peak = std::max(kinetic_peak, kinetic);
       if (s.time >= 1.5) {

@@ -12,6 +12,7 @@
 #include <random>
 #include <string>
 
+#include "materials/friction_angles.h"
 #include "materials/j2.h"
 #include "materials/material_driver.h"
 #include "materials/newtonian_fluid.h"
@@ -59,7 +60,7 @@ TEST_P(J2DriverTest, EveryPlasticStepEndsOnTheYieldSurface) {
     StepMaterialPoint(pt, RandomL(rng, rate) + (step % 600 < 300 ? 1 : -1) * rate *
                                                     Vec3(1, -0.5, -0.5).asDiagonal().toDenseMatrix(),
                       dt);
-    const History& h = pt.particles.history[0];
+    const History h = pt.particles.history.Get(0);
     const Real f = J2YieldFunction(p, Tau(pt), h);
     const Real radius = YieldRadius(p, h);
     if (h[kJ2PlasticStrain] > alpha_before) {
@@ -88,7 +89,7 @@ TEST_P(J2DriverTest, RigidRotationLeavesInvariantsUnchanged) {
   Real worst = 0;
   for (int r = 0; r < 20; ++r) {
     const Mat3 sigma0 = pt.particles.stress[0].matrix();
-    const Mat3 beta0 = J2BackStressOf(pt.particles.history[0]);
+    const Mat3 beta0 = J2BackStressOf(pt.particles.history.Get(0));
     const Real alpha0 = pt.particles.history[0][kJ2PlasticStrain];
     const Vec3 axis = Vec3(angle(rng), angle(rng), angle(rng)).normalized();
     const Mat3 R = Eigen::AngleAxis<Real>(angle(rng), axis).toRotationMatrix();
@@ -99,7 +100,7 @@ TEST_P(J2DriverTest, RigidRotationLeavesInvariantsUnchanged) {
     const Vec3 tol = 1e-10 * Vec3(scale, scale * scale, scale * scale * scale);
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(i1[i], i0[i], tol[i]) << "invariant " << i;
     EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(), 1e-10 * scale);
-    const Mat3 beta1 = J2BackStressOf(pt.particles.history[0]);
+    const Mat3 beta1 = J2BackStressOf(pt.particles.history.Get(0));
     EXPECT_LE((beta1 - R * beta0 * R.transpose()).norm(), 1e-10 * scale);
     EXPECT_NEAR(pt.particles.history[0][kJ2PlasticStrain], alpha0, 1e-12 * alpha0);
     worst = std::max(worst, (pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm() / scale);
@@ -205,8 +206,8 @@ TEST_P(J2DriverTest, UniaxialTensionFollowsTheClosedFormCurve) {
     UniaxialStep(pt, std::exp(-0.01 * (tau_peak - reverse) / E), dt, tol);
   }
   EXPECT_GT(pt.particles.history[0][kJ2PlasticStrain], alpha);
-  EXPECT_LE(std::abs(J2YieldFunction(p, Tau(pt), pt.particles.history[0])),
-            1e-8 * YieldRadius(p, pt.particles.history[0]));
+  EXPECT_LE(std::abs(J2YieldFunction(p, Tau(pt), pt.particles.history.Get(0))),
+            1e-8 * YieldRadius(p, pt.particles.history.Get(0)));
 }
 
 std::string HardeningName(const ::testing::TestParamInfo<std::array<Real, 2>>& info) {
@@ -337,6 +338,47 @@ TEST(NewtonianFluidDriverTest, TaitEquationOfState) {
   const NewtonianFluidParams& tait = std::get<NewtonianFluidParams>(pt.model.materials[0].params);
   const Real small = 1 - 1e-6;
   EXPECT_NEAR(FluidMeanStress(tait, small), K * std::log(small) / small, 1e-5 * K * 1e-6);
+}
+
+// A run stores only the history slots its models declare (HistorySlotsOf, Particles::history's
+// stride): each model with history is driven through a shear-and-compression path at the full
+// stride of the material driver, and the slots at and above its declared count must stay zero,
+// or the scene run would drop what the model wrote there.
+TEST(HistorySlotsTest, EveryModelWritesOnlyItsDeclaredSlots) {
+  const Real K = 1e7, G = 5e6;
+  const FrictionCurve sand{20, 7750, 3.33e-7, 150, 20, 300};  // Mast 2013 Table 3.5 i
+  MatsuokaNakaiParams mn_dp{K, G, 0, sand, false, MatsuokaNakaiPotential::kDruckerPrager};
+  const std::vector<std::pair<const char*, MaterialParams>> models = {
+      {"j2", J2Params{K, G, 1e4, 1e5, 1e5}},
+      {"drucker_prager", DruckerPragerParams{K, G, 0.2, 0.1, 1e4, 1e5, 1e5}},
+      {"drucker_prager_smooth_cap", SmoothCapDruckerPragerParams{K, G, 0.2, 1e4, 0.5}},
+      {"modified_drucker_prager", ModifiedDruckerPragerParams{K, G, 0, sand, false}},
+      {"matsuoka_nakai", MatsuokaNakaiParams{K, G, 0, sand, false}},
+      {"matsuoka_nakai_dp_potential", mn_dp},
+      {"mohr_coulomb", MohrCoulombParams{K, G, 0.5, 0.2, 1e4}},
+      {"tresca", TrescaParams{K, G, 1e4}},
+      {"snow", SnowParams{K, G, 1.0, 0.1, 0.5, 1.5e5}},
+      {"bingham_fluid", BinghamFluidParams{K, 5, 200, 500}},
+      {"frictional_fluid", FrictionalFluidParams{K, 5, 0.01, 10, 1e5}},
+  };
+  Mat3 L = Mat3::Zero();  // simple shear with compression [1/s]
+  L(0, 1) = 2.0;
+  L(1, 0) = 2.0;
+  L(1, 1) = -0.5;
+  for (const auto& [name, params] : models) {
+    SCOPED_TRACE(name);
+    const int slots = HistorySlotsOf(params);
+    ASSERT_GE(slots, 1);
+    ASSERT_LE(slots, kHistorySlots);
+    MaterialPoint pt = MakeMaterialPoint(Material{name, 2000.0, params}, -1e5 * Mat3::Identity());
+    ASSERT_EQ(pt.particles.history.stride(), kHistorySlots);  // the driver keeps every slot
+    for (int step = 0; step < 200; ++step) {
+      StepMaterialPoint(pt, L, 1e-3);
+      for (int k = slots; k < kHistorySlots; ++k)
+        ASSERT_EQ(pt.particles.history[0][k], 0.0) << "slot " << k << " at step " << step;
+    }
+    EXPECT_GT(pt.particles.history[0][kPlasticStrainSlot], 0.0) << "the path must be plastic";
+  }
 }
 
 }  // namespace

@@ -60,7 +60,7 @@ Material SandMaterial(const MatsuokaNakaiParams &p) {
 Mat3 Tau(const MaterialPoint &pt) {
   return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix();
 }
-const History &Hist(const MaterialPoint &pt) { return pt.particles.history[0]; }
+History Hist(const MaterialPoint& pt) { return pt.particles.history.Get(0); }
 Vec3 Principal(const Mat3 &a) {
   return Eigen::SelfAdjointEigenSolver<Mat3>(a, Eigen::EigenvaluesOnly)
       .eigenvalues();

@@ -55,7 +55,7 @@ TEST(ModifiedDruckerPragerTest, ReturnsLandOnTheFrozenConeAndAnglesFollowTheLaws
     int plastic = 0, apex = 0;
     Real worst = 0;
     for (int step = 0; step < 4000; ++step) {
-      const History before = pt.particles.history[0];
+      const History before = pt.particles.history.Get(0);
       // A shear in a fixed direction (reversed every 500 steps) plus random isochoric noise, and
       // a short hydrostatic stretch every 1000 steps to reach the apex.
       Mat3 L = RandomL(rng, 0.5);
@@ -65,7 +65,7 @@ TEST(ModifiedDruckerPragerTest, ReturnsLandOnTheFrozenConeAndAnglesFollowTheLaws
       L(1, 0) += sense * 2.0;
       if (step % 1000 >= 990) L = 20.0 * Mat3::Identity();
       StepMaterialPoint(pt, L, 1e-4);
-      const History& h = pt.particles.history[0];
+      const History h = pt.particles.history.Get(0);
       if (h[kMdpLambda] == before[kMdpLambda]) continue;
       ++plastic;
       const Mat3 tau = Tau(pt);
@@ -103,7 +103,7 @@ TEST(ModifiedDruckerPragerTest, RigidRotationLeavesInvariantsAndHistoryUnchanged
   std::uniform_real_distribution<Real> u(-3.0, 3.0);
   for (int r = 0; r < 10; ++r) {
     const Mat3 sigma0 = pt.particles.stress[0].matrix();
-    const History h0 = pt.particles.history[0];
+    const History h0 = pt.particles.history.Get(0);
     const Mat3 R =
         Eigen::AngleAxis<Real>(u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
     StepMaterialPoint(pt, (R - Mat3::Identity()) / 1e-4, 1e-4);  // f = R
@@ -213,7 +213,7 @@ TEST(ModifiedDruckerPragerTest, ShearingPathPeaksAtLambdaStarAndEndsAtA0) {
   MaterialPoint pt = MakeMaterialPoint(Sand(p), -100e3 * Mat3::Identity());
   History h0;
   InitialPlasticHistory(p, pt.particles.stress[0].matrix(), h0);
-  pt.particles.history[0] = h0;
+  pt.particles.history.Set(0, h0);
   EXPECT_NEAR(h0[kMdpFriction], a.a0 - a.a4, 1e-12) << "geostatic start: phi_F(I1, 0)";
   MixedControl m;
   m.stress_controlled = {false, true, true, true, true, true};
@@ -222,9 +222,9 @@ TEST(ModifiedDruckerPragerTest, ShearingPathPeaksAtLambdaStarAndEndsAtA0) {
   m.L(0, 0) = -1.0;  // axial compression, 5e-4 per step
   Real phi_peak = 0, lambda_peak = 0, worst_ratio = 0, dlambda_max = 0;
   for (int step = 0; step < 800; ++step) {
-    const History before = pt.particles.history[0];
+    const History before = pt.particles.history.Get(0);
     ASSERT_GE(MixedControlStep(pt, m, 5e-4, 1e-6), 0) << "step " << step;
-    const History& h = pt.particles.history[0];
+    const History h = pt.particles.history.Get(0);
     if (h[kMdpLambda] == before[kMdpLambda]) continue;
     dlambda_max = std::max(dlambda_max, h[kMdpLambda] - before[kMdpLambda]);
     // Triaxial compression on the cone of the frozen angle: q = 6 sin phi / (3 - sin phi) p'.
@@ -237,7 +237,7 @@ TEST(ModifiedDruckerPragerTest, ShearingPathPeaksAtLambdaStarAndEndsAtA0) {
       lambda_peak = h[kMdpLambda];
     }
   }
-  const History& h = pt.particles.history[0];
+  const History h = pt.particles.history.Get(0);
   std::printf("modified DP shearing path: peak phi_F %.4f deg at lambda %.5f (law: %.4f deg at "
               "lambda* %.5f, step dlambda <= %.2e); end lambda %.3f phi_F %.6f deg (a0 %g), "
               "phi_cs %.6f; max |q/p' - MC ratio of the frozen angle| %.2e\n",

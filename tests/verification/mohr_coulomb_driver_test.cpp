@@ -53,7 +53,7 @@ Material MaterialOf(const TrescaParams& p) { return Material{"clay", 1800.0, p};
 Mat3 Tau(const MaterialPoint& pt) {
   return pt.particles.F[0].determinant() * pt.particles.stress[0].matrix();
 }
-const History& Hist(const MaterialPoint& pt) { return pt.particles.history[0]; }
+History Hist(const MaterialPoint& pt) { return pt.particles.history.Get(0); }
 McRegion RegionOf(const MaterialPoint& pt) {
   return static_cast<McRegion>(static_cast<int>(Hist(pt)[kMcReturnRegion]));
 }

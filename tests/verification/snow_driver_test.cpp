@@ -39,7 +39,7 @@ Mat3 Tau(const MaterialPoint& pt) {
 }
 Real MeanPressure(const Mat3& tau) { return -tau.trace() / 3; }  // p, compression positive
 Real ShearStress(const Mat3& tau) { return std::sqrt(1.5) * Dev(tau).norm(); }  // q
-const History& Hist(const MaterialPoint& pt) { return pt.particles.history[0]; }
+History Hist(const MaterialPoint& pt) { return pt.particles.history.Get(0); }
 
 using testing::RandomL;
 

@@ -102,8 +102,9 @@ TaylorRun RunTaylor(const std::string& file, const std::vector<std::string>& ove
   });
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.steps = scene.state.step;
-  for (const History& h : scene.state.particles.history)
-    run.max_plastic_strain = std::max(run.max_plastic_strain, h[kPlasticStrainSlot]);
+  const HistoryArray& history = scene.state.particles.history;
+  for (size_t p = 0; p < history.size(); ++p)
+    run.max_plastic_strain = std::max(run.max_plastic_strain, history[p][kPlasticStrainSlot]);
   return run;
 }
 

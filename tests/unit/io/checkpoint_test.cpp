@@ -46,6 +46,12 @@ bool SameBytes(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
+bool SameBytes(const HistoryArray& a, const HistoryArray& b) {
+  return a.size() == b.size() && (a.size() == 0 || a.stride() == b.stride()) &&
+         (a.size() == 0 ||
+          std::memcmp(a.data(), b.data(), a.size() * size_t(a.stride()) * sizeof(Real)) == 0);
+}
+
 bool SameRigid(const std::vector<RigidBodyState>& a, const std::vector<RigidBodyState>& b) {
   if (a.size() != b.size()) return false;
   for (size_t k = 0; k < a.size(); ++k) {
@@ -81,7 +87,7 @@ Checkpoint FullCheckpoint(size_t n) {
     P.stress[p] = mat();
     P.strain[p] = mat();
     P.elastic_b[p] = mat();
-    for (Real& h : P.history[p]) h = u(rng);
+    for (int k = 0; k < P.history.stride(); ++k) P.history[p][k] = u(rng);
     P.mass[p] = u(rng);
     P.volume0[p] = u(rng);
     P.ext_force[p] = vec();
@@ -289,9 +295,14 @@ TEST_F(CheckpointTest, OptionalArraysRoundTripByLayout) {
   for (int mask = 0; mask < 32; ++mask) {
     Checkpoint c = FullCheckpoint(6);
     Particles& P = c.state.particles;
+    // The history's stride varies with the mask: a run stores only its models' slots.
     P.layout = ParticleLayout{bool(mask & 16), bool(mask & 1), bool(mask & 2), bool(mask & 4),
-                              bool(mask & 8)};
+                              bool(mask & 8), 1 + mask % kHistorySlots};
     P.Resize(3);  // drops the arrays the layout does not hold
+    ASSERT_EQ(P.history.size(), (mask & 4) ? 3u : 0u);
+    if (mask & 4) {
+      ASSERT_EQ(P.history.stride(), 1 + mask % kHistorySlots);
+    }
     ASSERT_EQ(P.strain.size(), (mask & 1) ? 3u : 0u);
     ASSERT_EQ(P.ext_force.size(), (mask & 8) ? 3u : 0u);
     c.state.groups = {{0, 0, 3}};
@@ -305,6 +316,9 @@ TEST_F(CheckpointTest, OptionalArraysRoundTripByLayout) {
     EXPECT_EQ(Q.layout.strain, P.layout.strain) << mask;
     EXPECT_EQ(Q.layout.elastic_b, P.layout.elastic_b) << mask;
     EXPECT_EQ(Q.layout.history, P.layout.history) << mask;
+    if (P.layout.history) {
+      EXPECT_EQ(Q.layout.history_slots, P.layout.history_slots) << mask;
+    }
     EXPECT_EQ(Q.layout.ext_force, P.layout.ext_force) << mask;
     EXPECT_TRUE(SameBytes(P.x, Q.x) && SameBytes(P.C, Q.C) && SameBytes(P.strain, Q.strain) &&
                 SameBytes(P.elastic_b, Q.elastic_b) && SameBytes(P.history, Q.history) &&

@@ -179,7 +179,7 @@ TEST(SceneBuilderTest, GeostaticJ2StateReproducesTheStress) {
     const Mat3 eps = eig.eigenvectors() * e.asDiagonal() * eig.eigenvectors().transpose();
     const Mat3 tau = 1.0e7 * eps.trace() * Mat3::Identity() + 2 * 5.0e6 * Dev(eps);
     EXPECT_LE((tau - P.stress[p].matrix()).norm(), 1e-9 * (1 + P.stress[p].matrix().norm())) << p;
-    EXPECT_EQ(P.history[p], History{});
+    EXPECT_EQ(P.history.Get(p), History{});
   }
 }
 
@@ -230,19 +230,23 @@ TEST(SceneBuilderTest, ParticleArraysFollowTheMaterials) {
   struct Case {
     std::string material, extra;
     bool strain, elastic_b, history, ext_force;
+    int history_slots;  // per particle, when history is held: the model's
   };
   const std::vector<Case> cases = {
       {"{model: linear_elastic, density: 2000, bulk_modulus: 1.0e7, shear_modulus: 5.0e6}", "",
-       true, false, false, false},
+       true, false, false, false, 0},
       {"{model: neo_hookean, density: 2000, bulk_modulus: 1.0e7, shear_modulus: 5.0e6}",
-       "    tractions: [{face: y+, traction: [0, -200]}]\n", false, false, false, true},
+       "    tractions: [{face: y+, traction: [0, -200]}]\n", false, false, false, true, 0},
       {"{model: drucker_prager_smooth_cap, density: 2000, bulk_modulus: 8.33e6, "
        "shear_modulus: 3.85e6, friction_angle_deg: 30, yield_stress: 10}",
-       "", false, true, true, false},
+       "", false, true, true, false, 3},
+      {"{model: drucker_prager, density: 2000, bulk_modulus: 5e6, shear_modulus: 3e6, "
+       "friction_angle_deg: 30, dilation_angle_deg: 0, cohesion: 0}",
+       "", false, true, true, false, 8},
       {"{model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e6, viscosity: 1.0e-3}", "", false,
-       false, false, false},
+       false, false, false, 0},
       {"{model: bingham_fluid, density: 1000, bulk_modulus: 2.0e6, viscosity: 1.0, yield_stress: 10}",
-       "", false, false, true, false},
+       "", false, false, true, false, 1},
   };
   for (const Case& c : cases) {
     std::string text = OneBody(2, "{box: {min: [0, 0], max: [1, 0.5]}}", 0.1, c.extra);
@@ -262,6 +266,10 @@ TEST(SceneBuilderTest, ParticleArraysFollowTheMaterials) {
     EXPECT_EQ(P.strain.size(), c.strain ? P.size() : 0u);
     EXPECT_EQ(P.elastic_b.size(), c.elastic_b ? P.size() : 0u);
     EXPECT_EQ(P.history.size(), c.history ? P.size() : 0u);
+    if (c.history) {
+      EXPECT_EQ(P.layout.history_slots, c.history_slots);
+      EXPECT_EQ(P.history.stride(), c.history_slots);
+    }
     EXPECT_EQ(P.ext_force.size(), c.ext_force ? P.size() : 0u);
   }
   for (const char* transfer : {"apic", "flip", "pic_flip"}) {
