@@ -3,6 +3,7 @@
 // Plasticity models of later issues add a struct here and a case in update_stress.cpp.
 #pragma once
 #include <cmath>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -46,6 +47,9 @@ struct MohrCoulombParams {
   Real friction_angle = 0;  // phi [rad], 0 <= phi < pi/2
   Real dilation_angle = 0;  // psi [rad], 0 <= psi <= phi
   Real cohesion = 0;        // c, Kirchhoff strength [Pa]; apex at tau_m = c cot(phi)
+  // Rankine tension cut-off t: tau_i <= t (Kirchhoff) [Pa]; infinity: none (the apex bounds
+  // tension). Associated flow on the cut-off planes (materials/mohr_coulomb.h).
+  Real tension_cutoff = std::numeric_limits<Real>::infinity();
 };
 
 // Tresca, elastic-perfectly plastic (Anura3D manual §7.1.2.1, (7.24)): max shear |tau_i - tau_j|/2
@@ -54,6 +58,7 @@ struct TrescaParams {
   Real bulk_modulus = 0;        // K [Pa]
   Real shear_modulus = 0;       // G [Pa]
   Real undrained_strength = 0;  // s_u, shear strength (Kirchhoff) [Pa]
+  Real tension_cutoff = std::numeric_limits<Real>::infinity();  // t as for Mohr-Coulomb [Pa]
 };
 
 // Dense snow: modified Cam-clay with cohesion (Gaume et al. 2018, Nat. Commun. 9:3047, Methods):

@@ -60,15 +60,97 @@ McReturn EdgeReturn(const McSurface& s, const Mat3& C, const Vec3& trial, int i,
   return r;
 }
 
+// Return with a Rankine tension cut-off (the PLAXIS Mohr-Coulomb option; Koiter's multi-surface
+// rule, as de Souza Neto et al. 2008 §8.2 apply it to the Mohr-Coulomb edges): the admissible set is the nine linear planes
+// a . tau <= k, the six Mohr-Coulomb planes f_ij (flow b = the potential g_ij) and the three
+// cut-off planes tau_i <= t (associated, b = e_i). By Koiter's rule the return is
+// tau = trial - sum_{active} dgamma_m C b_m with dgamma_m >= 0 and every active plane satisfied
+// with equality; for linear planes and linear elasticity each active set is one linear solve.
+// The sets are tried by size (1, 2, 3), cut-off planes first, and the first whose multipliers
+// are >= 0 and whose stress satisfies all nine planes is taken. At most three planes meet in a
+// point of principal space, so one of the sets is the answer (a plastic trial outside the set).
+McReturn TensionCutoffReturn(const McSurface& s, const Mat3& C, const Vec3& trial) {
+  struct Plane {
+    Vec3 a, cb;  // yield gradient, C times the flow direction
+    Real k;      // a . tau <= k
+  };
+  std::array<Plane, 9> planes;
+  int n = 0;
+  for (int i = 0; i < 3; ++i) planes[size_t(n++)] = Plane{Vec3::Unit(i), C * Vec3::Unit(i), s.tension};
+  const Real k_mc = 2.0 * s.cohesion * s.cos_phi;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (i != j)
+        planes[size_t(n++)] =
+            Plane{PlaneGradient(i, j, s.sin_phi), C * PlaneGradient(i, j, s.sin_psi), k_mc};
+  const Real scale = trial.cwiseAbs().maxCoeff() + k_mc + std::abs(s.tension);
+  const Real tol = 1e-11 * scale;
+  auto admissible = [&](const Vec3& tau) {
+    for (const Plane& p : planes)
+      if (p.a.dot(tau) - p.k > tol) return false;
+    return true;
+  };
+  // One active set: solve sum_m (a_l . C b_m) dgamma_m = a_l . trial - k_l (l, m in the set).
+  auto try_set = [&](const int* set, int size, McReturn& out) {
+    Mat3 A = Mat3::Identity();
+    Vec3 rhs = Vec3::Zero();
+    for (int l = 0; l < size; ++l) {
+      const Plane& pl = planes[size_t(set[l])];
+      rhs[l] = pl.a.dot(trial) - pl.k;
+      for (int m = 0; m < size; ++m) A(l, m) = pl.a.dot(planes[size_t(set[m])].cb);
+    }
+    // Dependent planes (a plane and its mirror, three Mohr-Coulomb planes through the apex
+    // line) give a singular system: skip, another set reaches the same point.
+    const Real det = A.determinant();
+    if (!(std::abs(det) > 1e-12 * std::pow(A.cwiseAbs().maxCoeff(), size))) return false;
+    const Vec3 dg = A.inverse() * rhs;
+    Vec3 tau = trial;
+    const Real dg_scale = dg.cwiseAbs().maxCoeff();
+    for (int m = 0; m < size; ++m) {
+      if (dg[m] < -1e-12 * dg_scale) return false;  // round-off at a region boundary passes
+      tau -= dg[m] * planes[size_t(set[m])].cb;
+    }
+    if (!admissible(tau)) return false;
+    out.tau = tau;
+    out.region = McRegion::kTension;
+    out.dgamma[0] = dg[0];
+    out.dgamma[1] = size > 1 ? dg[1] : 0;
+    return true;
+  };
+  McReturn r;
+  int set[3];
+  for (set[0] = 0; set[0] < 9; ++set[0])
+    if (try_set(set, 1, r)) return r;
+  for (set[0] = 0; set[0] < 9; ++set[0])
+    for (set[1] = set[0] + 1; set[1] < 9; ++set[1])
+      if (try_set(set, 2, r)) return r;
+  for (set[0] = 0; set[0] < 9; ++set[0])
+    for (set[1] = set[0] + 1; set[1] < 9; ++set[1])
+      for (set[2] = set[1] + 1; set[2] < 9; ++set[2])
+        if (try_set(set, 3, r)) return r;
+  // Not reached for a finite trial; keep the state admissible regardless: the hydrostatic
+  // point below both the cut-off and the apex.
+  const Real apex = s.sin_phi > 0 ? s.cohesion * s.cos_phi / s.sin_phi
+                                  : std::numeric_limits<Real>::infinity();
+  r.tau = Vec3::Constant(std::min(s.tension, apex));
+  r.region = McRegion::kTension;
+  return r;
+}
+
+// The return without a cut-off: main plane, edges, apex (below).
+McReturn MohrCoulombOnlyReturn(const McSurface& s, Real K, Real G, const Vec3& trial);
+
 }  // namespace
 
 McSurface SurfaceOf(const MohrCoulombParams& p) {
   return McSurface{std::sin(p.friction_angle), std::cos(p.friction_angle),
-                   std::sin(p.dilation_angle), p.cohesion};
+                   std::sin(p.dilation_angle), p.cohesion, p.tension_cutoff};
 }
 
 // Tresca (7.24) is Mohr-Coulomb with phi = psi = 0 and c = s_u (manual §7.1.2.1).
-McSurface SurfaceOf(const TrescaParams& p) { return McSurface{0, 1, 0, p.undrained_strength}; }
+McSurface SurfaceOf(const TrescaParams& p) {
+  return McSurface{0, 1, 0, p.undrained_strength, p.tension_cutoff};
+}
 
 Real MohrCoulombYield(const McSurface& s, const Vec3& tau) {
   // max_{i != j} f_ij: f_ij grows with tau_i and falls with tau_j (1 - sin(phi) >= 0), so the
@@ -78,6 +160,15 @@ Real MohrCoulombYield(const McSurface& s, const Vec3& tau) {
 }
 
 McReturn MohrCoulombReturn(const McSurface& s, Real K, Real G, const Vec3& trial) {
+  McReturn r = MohrCoulombOnlyReturn(s, K, G, trial);
+  // The cut-off acts where the Mohr-Coulomb state (elastic or returned) has tau_1 > t; tau_1 is
+  // the largest (the returns keep the order), so one comparison decides.
+  if (!(r.tau[0] > s.tension)) return r;  // (a NaN trial keeps the plain path)
+  return TensionCutoffReturn(s, PrincipalStiffness(K, G), trial);
+}
+
+namespace {
+McReturn MohrCoulombOnlyReturn(const McSurface& s, Real K, Real G, const Vec3& trial) {
   McReturn r;
   r.tau = trial;
   const Real f_trial = MohrCoulombYield(s, trial);  // f_13 of the sorted trial (7.26)
@@ -112,6 +203,7 @@ McReturn MohrCoulombReturn(const McSurface& s, Real K, Real G, const Vec3& trial
   r.dgamma[0] = r.dgamma[1] = 0;
   return r;
 }
+}  // namespace
 
 void MohrCoulombUpdate(const McSurface& s, Real K, Real G, const Mat3& f, Real J,
                        Mat3& elastic_b, History& h, Mat3& stress) {

@@ -8,6 +8,8 @@
 // Everything is in Kirchhoff stress tau = J sigma (Table 3.4): the cohesion c and s_u are
 // Kirchhoff strengths; the Cauchy strength is c / J (J stays near 1 for soils).
 #pragma once
+#include <limits>
+
 #include "core/particles.h"
 #include "materials/material_params.h"
 
@@ -31,6 +33,7 @@ enum class McRegion {
   kLeftEdge = 2,   // tau_1 = tau_2: triaxial compression meridian, planes f_13 = f_23 = 0
   kRightEdge = 3,  // tau_2 = tau_3: triaxial extension meridian, planes f_13 = f_12 = 0
   kApex = 4,       // tau_i = c cot(phi), deviator zero (phi > 0 only)
+  kTension = 5,    // on a tension cut-off plane tau_i = t (alone, at a corner or at tau = t 1)
 };
 
 // The six planes of a model as sines and cosines; Tresca is phi = psi = 0, c = s_u.
@@ -39,6 +42,7 @@ struct McSurface {
   Real cos_phi = 1;
   Real sin_psi = 0;
   Real cohesion = 0;  // c [Pa]
+  Real tension = std::numeric_limits<Real>::infinity();  // Rankine cut-off t: tau_i <= t [Pa]
 };
 McSurface SurfaceOf(const MohrCoulombParams& params);
 McSurface SurfaceOf(const TrescaParams& params);
@@ -51,6 +55,9 @@ Real MohrCoulombYield(const McSurface& surface, const Vec3& tau);
 // Principal return of the trial Kirchhoff stress `trial` sorted trial_1 >= trial_2 >= trial_3,
 // with the elastic principal block of [C^e_d] (K, G). `tau` keeps the order (tau_1 >= tau_2 >=
 // tau_3); dgamma holds the multipliers of the planes used (main, second) [-].
+// With a tension cut-off (surface.tension finite), a state whose Mohr-Coulomb return leaves
+// tau_1 > t is returned to the admissible set {f_ij <= 0, tau_i <= t} of all nine planes
+// (Koiter's multi-surface rule, exact for these linear planes: region kTension).
 struct McReturn {
   Vec3 tau = Vec3::Zero();
   McRegion region = McRegion::kElastic;

@@ -208,12 +208,13 @@ constexpr ParamDesc kMohrCoulombKeys[] = {
     {"friction_angle_deg", "deg", 0, false, 90, true, true},  // 0 <= phi < 90
     {"dilation_angle_deg", "deg", 0, false, 90, true, false},  // 0 <= psi <= phi, default 0
     {"cohesion", "Pa", 0, false, kInf, false, false},      // c >= 0, default 0
+    {"tension_cutoff", "Pa", 0, false, kInf, false, false, kInf},  // t >= 0, default none
 };
 MaterialParams MakeMohrCoulomb(const MaterialSpec& m) {
   return MohrCoulombParams{m.bulk_modulus, m.shear_modulus,
                            m.Param("friction_angle_deg") * std::numbers::pi / 180.0,
                            m.Param("dilation_angle_deg") * std::numbers::pi / 180.0,
-                           m.Param("cohesion")};
+                           m.Param("cohesion"), m.Param("tension_cutoff")};
 }
 // psi <= phi: a dilation angle above the friction angle gives more plastic work out than in
 // (Anura3D manual §7.1.2.2; Bolton (7.28) has phi = phi_cs + 0.8 psi >= psi).
@@ -227,9 +228,11 @@ std::optional<ParamError> CheckMohrCoulomb(const MaterialSpec& m) {
 Real MohrCoulombFrictionAngleDeg(const MaterialSpec& m) { return m.Param("friction_angle_deg"); }
 constexpr ParamDesc kTrescaKeys[] = {
     {"undrained_strength", "Pa", 0, true, kInf, false, true},  // s_u > 0
+    {"tension_cutoff", "Pa", 0, false, kInf, false, false, kInf},  // t >= 0, default none
 };
 MaterialParams MakeTresca(const MaterialSpec& m) {
-  return TrescaParams{m.bulk_modulus, m.shear_modulus, m.Param("undrained_strength")};
+  return TrescaParams{m.bulk_modulus, m.shear_modulus, m.Param("undrained_strength"),
+                      m.Param("tension_cutoff")};
 }
 
 // --- drucker_prager (Mast 2013 §3.6.1; spec §2.5) --------------------------------------------

@@ -574,6 +574,220 @@ CutRun RunCut(Real su) {
   return r;
 }
 
+// --- tension cut-off (Rankine planes tau_i <= t, associated) -----------------------------------
+
+// Random sorted trials (a quarter of them near the hydrostatic axis) for Mohr-Coulomb (phi = 30,
+// psi = 10 deg, c = 20 kPa: apex 34.6 kPa) and Tresca (s_u = 30 kPa) with t = 10 kPa. Where the plain return keeps tau_1 <= t the cut-off
+// return is bitwise the plain one; elsewhere it ends on tau_1 = t inside all nine planes (1e-8
+// relative), in order, with multipliers >= 0, and every branch is reached: tau_1 = t alone (its
+// plastic strain along e_1 only), tau_1 = tau_2 = t, tau = t 1, and a corner with a Mohr-Coulomb
+// plane.
+TEST(MohrCoulombCutoffTest, RandomTrialsEndInsideAllNinePlanes) {
+  for (const bool tresca : {false, true}) {
+    const MohrCoulombParams sand = Sand(30, 10, 20e3);
+    const TrescaParams clay = Clay(30e3);
+    McSurface s = tresca ? SurfaceOf(clay) : SurfaceOf(sand);
+    const Real K = tresca ? clay.bulk_modulus : sand.bulk_modulus;
+    const Real G = tresca ? clay.shear_modulus : sand.shear_modulus;
+    const McSurface plain = s;
+    s.tension = 10e3;
+    const Real t = s.tension;
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<Real> u(-300e3, 300e3), near(-20e3, 20e3);
+    int same = 0, single = 0, pair = 0, triple = 0, corner = 0;
+    for (int n = 0; n < 20000; ++n) {
+      // Every fourth trial near the hydrostatic axis (Tresca reaches tau = t 1 only from there).
+      Vec3 trial(u(rng), u(rng), u(rng));
+      if (n % 4 == 0) trial = Vec3::Constant(trial[0]) + Vec3(near(rng), near(rng), near(rng));
+      std::sort(trial.data(), trial.data() + 3, std::greater<Real>());
+      const McReturn r0 = MohrCoulombReturn(plain, K, G, trial);
+      const McReturn r = MohrCoulombReturn(s, K, G, trial);
+      if (r0.tau[0] <= t) {
+        ASSERT_EQ(r.region, r0.region);
+        for (int i = 0; i < 3; ++i) ASSERT_EQ(r.tau[i], r0.tau[i]);
+        ++same;
+        continue;
+      }
+      const Real scale = YieldScale(s, trial) + t;
+      ASSERT_EQ(r.region, McRegion::kTension) << "trial " << trial.transpose();
+      ASSERT_NEAR(r.tau[0], t, 1e-8 * scale) << "trial " << trial.transpose();
+      ASSERT_LE(MohrCoulombYield(s, r.tau), 1e-8 * scale) << "trial " << trial.transpose();
+      ASSERT_GE(r.tau[0] - r.tau[1], -1e-8 * scale);
+      ASSERT_GE(r.tau[1] - r.tau[2], -1e-8 * scale);
+      ASSERT_GE(r.dgamma[0], 0);
+      ASSERT_GE(r.dgamma[1], 0);
+      const bool on2 = std::abs(r.tau[1] - t) <= 1e-8 * scale;
+      const bool on3 = std::abs(r.tau[2] - t) <= 1e-8 * scale;
+      const bool on_mc = std::abs(MohrCoulombYield(s, r.tau)) <= 1e-8 * scale;
+      if (on3) {
+        ++triple;
+      } else if (on2) {
+        ++pair;
+      } else if (on_mc) {
+        ++corner;
+      } else {
+        ++single;
+        // Associated Rankine flow: the plastic strain of tau_1 = t alone is along e_1.
+        const Vec3 deps_p = HenckyStrain(K, G, trial) - HenckyStrain(K, G, r.tau);
+        ASSERT_GT(deps_p[0], 0);
+        ASSERT_NEAR(deps_p[1], 0, 1e-8 * deps_p[0]);
+        ASSERT_NEAR(deps_p[2], 0, 1e-8 * deps_p[0]);
+      }
+    }
+    std::printf("%s with a 10 kPa cut-off, 20000 random trials: plain return kept %d, tau_1 = t "
+                "%d, tau_1 = tau_2 = t %d, tau = t 1 %d, corner with a shear plane %d\n",
+                tresca ? "Tresca" : "Mohr-Coulomb", same, single, pair, triple, corner);
+    EXPECT_GT(same, 1000);
+    EXPECT_GT(single, 100);
+    EXPECT_GT(pair, 20);
+    EXPECT_GT(triple, 20);
+    EXPECT_GT(corner, 100);
+  }
+}
+
+// The engine's one-point update with a cut-off (t = 5 kPa) on random paths biased to tension:
+// every step ends inside all nine planes, coaxial with the trial and in its order, the cut-off is
+// reached often, and then rigid rotations rotate the stress (objectivity).
+TEST(MohrCoulombCutoffTest, RandomPathsStayInsideAndRotationsRotateTheStress) {
+  for (const bool tresca : {false, true}) {
+    MohrCoulombParams sand = Sand(30, 10, 20e3);
+    TrescaParams clay = Clay(30e3);
+    sand.tension_cutoff = clay.tension_cutoff = 5e3;
+    const Material mat = tresca ? MaterialOf(clay) : MaterialOf(sand);
+    const McSurface s = tresca ? SurfaceOf(clay) : SurfaceOf(sand);
+    const Real K = tresca ? clay.bulk_modulus : sand.bulk_modulus;
+    const Real G = tresca ? clay.shear_modulus : sand.shear_modulus;
+    MaterialPoint pt = MakeMaterialPoint(mat, -20e3 * Mat3::Identity());
+    const Real dt = 1e-3, rate = 0.3 * 20e3 / G / dt;
+    RandomPath path(23, rate, {0.3, 0.6, -0.2});
+    int cut = 0;
+    for (int step = 0; step < 3000; ++step) {
+      const Mat3 L = path.Next();
+      const HenckyTrial t = HenckyTrialState(K, G, Mat3::Identity() + dt * L,
+                                             pt.particles.elastic_b[0]);
+      StepMaterialPoint(pt, L, dt);
+      const Mat3 tau = Tau(pt);
+      const Vec3 tp = Principal(tau);
+      const Real scale = YieldScale(s, tp) + s.tension;
+      ASSERT_LE(MohrCoulombYield(s, tp), 1e-8 * scale) << "step " << step;
+      ASSERT_LE(tp[0] - s.tension, 1e-8 * scale) << "step " << step;
+      if (RegionOf(pt) == McRegion::kElastic) continue;
+      cut += RegionOf(pt) == McRegion::kTension;
+      const Mat3 hat = t.Q.transpose() * tau * t.Q;
+      ASSERT_LE((hat - Mat3(hat.diagonal().asDiagonal())).norm(), 1e-10 * scale);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          if (t.tau[i] > t.tau[j]) ASSERT_GE(hat(i, i) - hat(j, j), -1e-8 * scale);
+        }
+    }
+    std::printf("%s, t = 5 kPa, 3000-step random path: %d steps on the cut-off\n",
+                tresca ? "Tresca" : "Mohr-Coulomb", cut);
+    EXPECT_GE(cut, 50);
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<Real> angle(-3.0, 3.0);
+    for (int r = 0; r < 10; ++r) {
+      const Mat3 sigma0 = pt.particles.stress[0].matrix();
+      const Mat3 R = Eigen::AngleAxis<Real>(
+          angle(rng), Vec3(angle(rng), angle(rng), angle(rng)).normalized()).toRotationMatrix();
+      StepMaterialPoint(pt, (R - Mat3::Identity()) / dt, dt);
+      EXPECT_LE((pt.particles.stress[0].matrix() - R * sigma0 * R.transpose()).norm(),
+                1e-10 * (sigma0.norm() + s.tension));
+    }
+  }
+}
+
+// Hydrostatic extension with t = 10 kPa below the apex (34.6 kPa): tau -> t 1, zero deviator, and
+// all volume change beyond it plastic.
+TEST(MohrCoulombCutoffTest, HydrostaticTensionStopsAtTheCutoff) {
+  MohrCoulombParams p = Sand(30, 10, 20e3);
+  p.tension_cutoff = 10e3;
+  MaterialPoint pt = MakeMaterialPoint(MaterialOf(p), -50e3 * Mat3::Identity());
+  const Real dt = 1e-3, rate = 0.5e-3 / dt;
+  int cut_steps = 0;
+  for (int n = 0; n < 20; ++n) {
+    StepMaterialPoint(pt, rate * Mat3::Identity(), dt);
+    if (RegionOf(pt) != McRegion::kTension) continue;
+    ++cut_steps;
+    EXPECT_NEAR(Tau(pt).trace() / 3, 10e3, 1e-9 * 10e3);
+    EXPECT_LE(Dev(Tau(pt)).norm(), 1e-9 * 10e3);
+  }
+  EXPECT_GE(cut_steps, 15);
+  const Real lnJ = std::log(pt.particles.F[0].determinant());
+  EXPECT_NEAR(Hist(pt)[kMcVolumetricPlastic], lnJ - (10e3 + 50e3) / p.bulk_modulus, 1e-12);
+}
+
+// Uniaxial strain extension f = diag(1 + e, 1, 1) from zero stress: the axial stress rises
+// elastically (lateral nu/(1 - nu) of it) to t = 10 kPa and stays there, the lateral stresses
+// frozen (the cut-off's plastic strain is axial only); without the cut-off it passes t and
+// yields on the shear plane (tau_xx = 26 kPa).
+TEST(MohrCoulombCutoffTest, UniaxialExtensionHoldsTheAxialStressAtTheCutoff) {
+  MohrCoulombParams p = Sand(30, 10, 20e3);
+  const MohrCoulombParams plain = p;
+  p.tension_cutoff = 10e3;
+  MaterialPoint pt = MakeMaterialPoint(MaterialOf(p)), ref = MakeMaterialPoint(MaterialOf(plain));
+  const Real dt = 1e-3;
+  Mat3 L = Mat3::Zero();
+  L(0, 0) = 2e-5 / dt;  // 2e-5 strain per step: t / E' = 1.7e-4, about 8 steps to the cut-off
+  Real lateral_at_cut = 0;
+  int cut_steps = 0;
+  for (int n = 0; n < 60; ++n) {
+    StepMaterialPoint(pt, L, dt);
+    StepMaterialPoint(ref, L, dt);
+    const Mat3 tau = Tau(pt);
+    EXPECT_LE(tau(0, 0), 10e3 * (1 + 1e-10));
+    if (RegionOf(pt) != McRegion::kTension) continue;
+    if (cut_steps++ == 0) lateral_at_cut = tau(1, 1);
+    EXPECT_NEAR(tau(0, 0), 10e3, 1e-9 * 10e3);
+    EXPECT_NEAR(tau(1, 1), lateral_at_cut, 1e-9 * 10e3);
+    EXPECT_NEAR(tau(2, 2), lateral_at_cut, 1e-9 * 10e3);
+  }
+  std::printf("MC uniaxial extension, t = 10 kPa: %d of 60 steps on the cut-off, tau_xx %.6e, "
+              "tau_yy %.6e (nu/(1-nu) t = %.6e); without: tau_xx %.6e\n", cut_steps,
+              Tau(pt)(0, 0), Tau(pt)(1, 1), 10e3 / 3, Tau(ref)(0, 0));
+  EXPECT_GE(cut_steps, 45);
+  EXPECT_NEAR(lateral_at_cut, 10e3 / 3, 0.05 * 10e3 / 3);  // nu/(1 - nu) = 1/3, finite strain
+  EXPECT_GT(Tau(ref)(0, 0), 2 * 10e3);
+}
+
+// A 1 m tall block of cohesive soil (c = 50 kPa, phi = 30 deg: apex 86.6 kPa) hangs from a
+// no-slip ceiling under gravity: the top carries rho g L = 19.6 kPa of tension. Without a cut-off
+// it hangs (mean drop of millimetres); with t = 5 kPa the top fails in tension and the block falls.
+Real HangingBlockDrop(const std::string& cutoff) {
+  const std::string text =
+      "name: hanging_block_2d\n"
+      "dimension: 2\n"
+      "time: {end: 0.6, cfl: 0.4}\n"
+      "gravity: [0, -9.81]\n"
+      "gravity_ramp: 0.2\n"
+      "grid: {cell_size: 0.05}\n"
+      "domain: {min: [0, 0], max: [1.0, 2.0], walls: {y-: slip, y+: no_slip}}\n"
+      "materials:\n"
+      "  soil: {model: mohr_coulomb, density: 2000, youngs_modulus: 5.0e6, poisson_ratio: 0.3, "
+      "friction_angle_deg: 30, cohesion: 5.0e4" + cutoff + "}\n"
+      "bodies:\n"
+      "  - name: block\n"
+      "    material: soil\n"
+      "    region: {box: {min: [0.25, 1.0], max: [0.75, 2.0]}}\n"
+      "    particles_per_cell: 2\n";
+  LoadedScene scene = LoadSceneFromString(text, "hanging_block_2d.yaml");
+  auto mean_y = [](const Particles& P) {
+    Real m = 0, my = 0;
+    for (size_t i = 0; i < P.size(); ++i) m += P.mass[i], my += P.mass[i] * P.x[i].y();
+    return my / m;
+  };
+  const Real y0 = mean_y(scene.state.particles);
+  testing::RunUntil(scene, 0.6, [](const State&, const StepReport&) {});
+  return y0 - mean_y(scene.state.particles);
+}
+
+TEST(MohrCoulombCutoffTest, BlockHangingFromACeilingFallsOnlyWithTheCutoff) {
+  const Real hangs = HangingBlockDrop(""), falls = HangingBlockDrop(", tension_cutoff: 5.0e3");
+  std::printf("hanging block, 0.6 s: mean drop %.5f m without a cut-off, %.4f m with t = 5 kPa\n",
+              hangs, falls);
+  EXPECT_LT(hangs, 0.01);
+  EXPECT_GT(falls, 0.2);
+}
+
 TEST(TrescaCutTest, CutStandsWithStrongClayAndCollapsesWithWeakClay) {
   const CutRun strong = RunCut(20e3), weak = RunCut(2e3);
   std::printf("Tresca vertical cut H = 1 m, gamma = 19.6 kN/m^3, t = 1.2 s: s_u = 20 kPa: max dx "

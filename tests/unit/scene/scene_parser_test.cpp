@@ -2,6 +2,7 @@
 // --set overrides; resolved YAML reads back to the same model.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -344,6 +345,15 @@ TEST(SceneParserTest, MohrCoulombAndTrescaKeys) {
   const LoadedScene clay = LoadSceneFromString(
       WithMaterial(tresca + ", undrained_strength: 2e4}"), "ok.yaml");
   EXPECT_EQ(std::get<TrescaParams>(clay.model.materials[0].params).undrained_strength, 2e4);
+  // The tension cut-off: t >= 0, none (infinity) when not written.
+  ExpectError(WithMaterial(mc + "friction_angle_deg: 30, tension_cutoff: -5}"), 7,
+              "materials.steel.tension_cutoff", "must be >= 0 [Pa], got -5");
+  ExpectError(WithMaterial(tresca + ", undrained_strength: 2e4, tension_cutoff: -1}"), 7,
+              "materials.steel.tension_cutoff", "must be >= 0 [Pa], got -1");
+  EXPECT_TRUE(std::isinf(p.tension_cutoff));
+  const LoadedScene cut = LoadSceneFromString(
+      WithMaterial(tresca + ", undrained_strength: 2e4, tension_cutoff: 5e3}"), "ok.yaml");
+  EXPECT_EQ(std::get<TrescaParams>(cut.model.materials[0].params).tension_cutoff, 5e3);
 }
 
 TEST(SceneParserTest, GeostaticOnFluid) {
