@@ -5,6 +5,7 @@
 #include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <mutex>
 #include <stdexcept>
 
@@ -80,9 +81,20 @@ void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid) 
     grid.colour[c].push_back(static_cast<int32_t>(b));
   }
   const size_t nodes = count * size_t(grid.block_nodes);
-  grid.mass.assign(nodes, 0.0);
-  grid.momentum.assign(nodes, Vec3::Zero());
-  grid.force.assign(nodes, Vec3::Zero());
+  // The P2G sums start at zero: cleared block by block in parallel (a serial clear of 56 bytes
+  // per node was a tenth of a small run's grid rebuild).
+  grid.mass.resize(nodes);
+  grid.momentum.resize(nodes);
+  grid.force.resize(nodes);
+  const size_t per_block = size_t(grid.block_nodes);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16), [&](const tbb::blocked_range<size_t>& r) {
+    const size_t begin = r.begin() * per_block, end = r.end() * per_block;
+    std::fill(grid.mass.begin() + ptrdiff_t(begin), grid.mass.begin() + ptrdiff_t(end), 0.0);
+    std::fill(grid.momentum.begin() + ptrdiff_t(begin), grid.momentum.begin() + ptrdiff_t(end),
+              Vec3::Zero());
+    std::fill(grid.force.begin() + ptrdiff_t(begin), grid.force.begin() + ptrdiff_t(end),
+              Vec3::Zero());
+  });
   grid.velocity.resize(nodes);
   grid.velocity_new.resize(nodes);
   grid.reaction.resize(nodes);

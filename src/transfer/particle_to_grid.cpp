@@ -1,6 +1,10 @@
 // P2G (Mast 2013 eq. (2.12)): mass, momentum (+ APIC affine term), internal and traction forces.
 // Blocks are processed colour by colour; a block accumulates its particles into a padded local
 // buffer and adds it into itself and its 7 upper neighbours (no atomics, fixed summation order).
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
 #include <type_traits>
 
 #include "core/check.h"
@@ -25,11 +29,12 @@ struct FieldAccum {
 // Adds a block's per-field padded sums into the field arrays and, field by field in a fixed
 // order, into the common field.
 template <class Pad>
-void FlushFields(SparseGrid& grid, size_t blk, const std::vector<FieldAccum>& buf) {
+void FlushFields(SparseGrid& grid, size_t blk, const std::vector<FieldAccum>& buf, int xlo,
+                 int xhi) {
   const size_t nodes = grid.mass.size();
   for (int f = 0; f < grid.field_count; ++f) {
     const FieldAccum* fb = buf.data() + size_t(f) * Pad::kSize;
-    for (int a = 0; a < Pad::E; ++a)
+    for (int a = xlo; a < xhi; ++a)
       for (int b = 0; b < Pad::E; ++b)
         for (int c = 0; c < Pad::Ez; ++c) {
           const FieldAccum& n = fb[Pad::Index(a, b, c)];
@@ -54,10 +59,13 @@ void FlushFields(SparseGrid& grid, size_t blk, const std::vector<FieldAccum>& bu
 // buffer per velocity field (body_field maps a particle's body to its field), written to the
 // grid's field arrays and summed into the common field (Anura3D manual (6.1)-(6.3): the common
 // field is the sum of the body fields).
+// [xlo, xhi): the slab of padded x node columns this call accumulates and writes (all: 0 to
+// Pad::E). Calls on disjoint slabs of one block may run in parallel: each node still sums the
+// block's particles in their sorted order, so the result is the same bitwise for any split.
 template <int kDim, class K, bool kApic, bool kFull, bool kFields = false>
 void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, size_t blk,
                   std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>>& buf,
-                  const int* body_field = nullptr) {
+                  const int* body_field, int xlo, int xhi) {
   using Pad = BlockPad<kDim, K>;
   using Accum = std::conditional_t<kFields, FieldAccum, NodeAccum>;
   const int fields = kFields ? grid.field_count : 1;
@@ -72,6 +80,8 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
     Stencil<kDim, K> st;
     st.Compute(x, ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
     const Vec3i lb = st.base - origin;
+    const int i_begin = std::max(0, xlo - lb.x()), i_end = std::min(st.W, xhi - lb.x());
+    if (i_begin >= i_end) continue;  // the particle's stencil misses this slab
     const Real m = P.mass[p];
     const Vec3& vp = P.v[p];
     const Real mv[3] = {m * vp.x(), m * vp.y(), m * vp.z()};
@@ -108,7 +118,7 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
     //             fa_ij = S (gx_ij, gy_ij, 0) + wxy f_ext,  fb_ij = wxy S[:,2]
     Real wk_oz[Stencil<kDim, K>::W];
     for (int k = 0; k < st.Wz; ++k) wk_oz[k] = st.w[2][k] * off[2][k];
-    for (int i = 0; i < st.W; ++i) {
+    for (int i = i_begin; i < i_end; ++i) {
       for (int j = 0; j < st.W; ++j) {
         const Real wxy = st.w[0][i] * st.w[1][j];
         const Real wm = wxy * m;
@@ -188,9 +198,9 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
     }
   }
   if constexpr (kFields) {
-    FlushFields<Pad>(grid, blk, buf);
+    FlushFields<Pad>(grid, blk, buf, xlo, xhi);
   } else {
-    for (int a = 0; a < Pad::E; ++a)
+    for (int a = xlo; a < xhi; ++a)
       for (int b = 0; b < Pad::E; ++b)
         for (int c = 0; c < Pad::Ez; ++c) {
           const NodeAccum& n = buf[Pad::Index(a, b, c)];
@@ -212,12 +222,25 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
 template <int kDim, class K, bool kApic, bool kFull, bool kFields>
 void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& grid,
              const int* body_field) {
+  using Pad = BlockPad<kDim, K>;
+  const size_t threads = std::min(
+      size_t(tbb::this_task_arena::max_concurrency()),
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
-    ParallelFor(blocks.size(), 1, [&](size_t i) {
+    // A colour with few blocks (small runs: a 1e4-particle column has one or two per colour)
+    // is split further into slabs of padded x columns, so that every thread has work; a slab
+    // repeats the stencil weights of the particles it touches. The sums do not depend on the
+    // split (ScatterBlock), so the split may follow the thread count.
+    const size_t slabs = threads <= 1 || blocks.size() >= 4 * threads ? 1
+                         : blocks.size() >= threads                 ? 2
+                                                                    : 4;
+    ParallelFor(blocks.size() * slabs, 1, [&](size_t t) {
       thread_local std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>> buf;
-      ScatterBlock<kDim, K, kApic, kFull, kFields>(ctx, particles, grid, blocks[i], buf,
-                                                   body_field);
+      const size_t b = t / slabs, s = t % slabs;
+      const int xlo = int(size_t(Pad::E) * s / slabs), xhi = int(size_t(Pad::E) * (s + 1) / slabs);
+      ScatterBlock<kDim, K, kApic, kFull, kFields>(ctx, particles, grid, blocks[b], buf,
+                                                   body_field, xlo, xhi);
     });
   }
 }

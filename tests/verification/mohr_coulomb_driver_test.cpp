@@ -677,7 +677,9 @@ TEST(MohrCoulombCutoffTest, RandomPathsStayInsideAndRotationsRotateTheStress) {
       ASSERT_LE((hat - Mat3(hat.diagonal().asDiagonal())).norm(), 1e-10 * scale);
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
-          if (t.tau[i] > t.tau[j]) ASSERT_GE(hat(i, i) - hat(j, j), -1e-8 * scale);
+          if (t.tau[i] > t.tau[j]) {
+            ASSERT_GE(hat(i, i) - hat(j, j), -1e-8 * scale);
+          }
         }
     }
     std::printf("%s, t = 5 kPa, 3000-step random path: %d steps on the cut-off\n",
