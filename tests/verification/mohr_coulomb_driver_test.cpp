@@ -14,6 +14,10 @@
 //    to tau = c cos(phi) + sigma_n sin(phi) (psi = 0, constant sigma_n).
 //  - Engine: a 1 m vertical cut in Tresca clay stands for s_u = 20 kPa (gamma H / s_u = 0.98 < 2,
 //    the lower bound) and collapses for s_u = 2 kPa (gamma H / s_u = 9.8 > 3.83, the upper bound).
+//  - Tension cut-off (MohrCoulombCutoffTest): random trials and paths end inside all nine planes,
+//    every branch reached; hydrostatic and uniaxial extension stop at t; a block hanging from a
+//    ceiling falls only with a cut-off; with t = 0 the cut fails at gamma H / s_u = 3.2 (stands
+//    without) and stands at 2.4 (Terzaghi's cracked critical height 2.67).
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -530,7 +534,7 @@ TEST(SimpleShearTest, HorizontalShearStressApproachesThePlaneStrength) {
 // A 1 m high, 1.5 m wide block of Tresca clay (rho = 2000 kg/m^3) against a smooth wall at x = 0
 // on a rough floor: a vertical cut at x = 1.5 m. Limit analysis (Chen 1975): the cut stands if
 // gamma H / s_u < 2 (lower bound) and collapses if gamma H / s_u > 3.83 (upper bound).
-std::string CutScene(Real su) {
+std::string CutScene(Real su, const std::string& extra = "") {
   return "name: tresca_cut_2d\n"
          "dimension: 2\n"
          "time: {end: 1.2, cfl: 0.4}\n"
@@ -540,7 +544,7 @@ std::string CutScene(Real su) {
          "domain: {min: [0, 0], max: [3.5, 1.5], walls: {x-: slip, y-: no_slip}}\n"
          "materials:\n"
          "  clay: {model: tresca, density: 2000, youngs_modulus: 5.0e6, poisson_ratio: 0.3, "
-         "undrained_strength: " + std::to_string(su) + "}\n"
+         "undrained_strength: " + std::to_string(su) + extra + "}\n"
          "bodies:\n"
          "  - name: cut\n"
          "    material: clay\n"
@@ -554,9 +558,9 @@ struct CutRun {
   Real max_eps_p;   // largest equivalent plastic strain
   Real seconds;     // wall time
 };
-CutRun RunCut(Real su) {
+CutRun RunCut(Real su, const std::string& extra = "") {
   const auto start = std::chrono::steady_clock::now();
-  LoadedScene scene = LoadSceneFromString(CutScene(su), "tresca_cut_2d.yaml");
+  LoadedScene scene = LoadSceneFromString(CutScene(su, extra), "tresca_cut_2d.yaml");
   const Particles& P = scene.state.particles;
   std::vector<Real> x0(P.size());  // by particle id (the engine may reorder particles)
   for (size_t i = 0; i < P.size(); ++i) x0[P.id[i]] = P.x[i].x();
@@ -801,6 +805,26 @@ TEST(TrescaCutTest, CutStandsWithStrongClayAndCollapsesWithWeakClay) {
   EXPECT_LT(strong.mean_speed, 0.01);
   EXPECT_GT(weak.max_dx, 0.2);
   EXPECT_GT(weak.max_eps_p, 0.1);
+}
+
+// Tension cracks lower the critical height of the cut (Terzaghi 1943, Theoretical Soil Mechanics:
+// H_c = 4 s_u / gamma without and about 2.67 s_u / gamma with a tension crack; Chen's 3.83 is
+// the upper bound without). With t = 0 the clay cannot carry the tension behind the crest. At
+// gamma H / s_u = 3.2, between the two, the cut stands without a cut-off and collapses with
+// t = 0; at 2.4, below 2.67, it also stands with t = 0 (a crack opens, the block stops).
+TEST(TrescaCutTest, TensionCutoffLowersTheCriticalHeightToTheCrackedValue) {
+  const Real gamma = 2000 * 9.81;
+  const CutRun plain = RunCut(gamma / 3.2), cracked = RunCut(gamma / 3.2, ", tension_cutoff: 0");
+  const CutRun low = RunCut(gamma / 2.4, ", tension_cutoff: 0");
+  std::printf("Tresca cut, t = 1.2 s: gamma H / s_u = 3.2: max dx %.4f m, speed %.4f m/s without a "
+              "cut-off; %.3f m, %.3f m/s with t = 0; gamma H / s_u = 2.4 with t = 0: %.4f m, "
+              "%.4f m/s\n", plain.max_dx, plain.mean_speed, cracked.max_dx, cracked.mean_speed,
+              low.max_dx, low.mean_speed);
+  EXPECT_LT(plain.max_dx, 0.01);
+  EXPECT_LT(plain.mean_speed, 0.01);
+  EXPECT_GT(cracked.max_dx, 0.2);
+  EXPECT_LT(low.max_dx, 0.05);
+  EXPECT_LT(low.mean_speed, 0.01);
 }
 
 }  // namespace
