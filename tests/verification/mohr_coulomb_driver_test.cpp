@@ -31,6 +31,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "../support/run_scene.h"
 #include "materials/hencky.h"
@@ -531,36 +532,22 @@ TEST(SimpleShearTest, HorizontalShearStressApproachesThePlaneStrength) {
 
 // --- engine run -------------------------------------------------------------------------------
 
-// A 1 m high, 1.5 m wide block of Tresca clay (rho = 2000 kg/m^3) against a smooth wall at x = 0
-// on a rough floor: a vertical cut at x = 1.5 m. Limit analysis (Chen 1975): the cut stands if
-// gamma H / s_u < 2 (lower bound) and collapses if gamma H / s_u > 3.83 (upper bound).
-std::string CutScene(Real su, const std::string& extra = "") {
-  return "name: tresca_cut_2d\n"
-         "dimension: 2\n"
-         "time: {end: 1.2, cfl: 0.4}\n"
-         "gravity: [0, -9.81]\n"
-         "gravity_ramp: 0.3\n"
-         "grid: {cell_size: 0.1}\n"
-         "domain: {min: [0, 0], max: [3.5, 1.5], walls: {x-: slip, y-: no_slip}}\n"
-         "materials:\n"
-         "  clay: {model: tresca, density: 2000, youngs_modulus: 5.0e6, poisson_ratio: 0.3, "
-         "undrained_strength: " + std::to_string(su) + extra + "}\n"
-         "bodies:\n"
-         "  - name: cut\n"
-         "    material: clay\n"
-         "    region: {box: {min: [0, 0], max: [1.5, 1.0]}}\n"
-         "    particles_per_cell: 2\n";
-}
-
+// scenes/vertical_cut_2d.yaml: a 1 m high, 1.5 m wide block of Tresca clay (rho = 2000 kg/m^3)
+// against a smooth wall at x = 0 on a rough floor: a vertical cut at x = 1.5 m, s_u from the
+// stability number N = gamma H / s_u. Limit analysis (Chen 1975): the cut stands if N < 2 (lower
+// bound) and collapses if N > 3.83 (upper bound). The scene has tension_cutoff: 0; `cutoff`
+// false lifts it out of reach (1e12 Pa: the cut-off never acts, bitwise as without the key).
 struct CutRun {
   Real max_dx;      // largest horizontal displacement of a particle [m]
   Real mean_speed;  // mass-weighted mean speed at the end [m/s]
   Real max_eps_p;   // largest equivalent plastic strain
   Real seconds;     // wall time
 };
-CutRun RunCut(Real su, const std::string& extra = "") {
+CutRun RunCut(Real N, bool cutoff) {
   const auto start = std::chrono::steady_clock::now();
-  LoadedScene scene = LoadSceneFromString(CutScene(su, extra), "tresca_cut_2d.yaml");
+  std::vector<std::string> overrides = {"parameters.N=" + std::to_string(N)};
+  if (!cutoff) overrides.push_back("materials.clay.tension_cutoff=1e12");
+  LoadedScene scene = LoadScene(testing::ScenePath("vertical_cut_2d.yaml"), overrides);
   const Particles& P = scene.state.particles;
   std::vector<Real> x0(P.size());  // by particle id (the engine may reorder particles)
   for (size_t i = 0; i < P.size(); ++i) x0[P.id[i]] = P.x[i].x();
@@ -795,7 +782,8 @@ TEST(MohrCoulombCutoffTest, BlockHangingFromACeilingFallsOnlyWithTheCutoff) {
 }
 
 TEST(TrescaCutTest, CutStandsWithStrongClayAndCollapsesWithWeakClay) {
-  const CutRun strong = RunCut(20e3), weak = RunCut(2e3);
+  const Real gamma = 2000 * 9.81;
+  const CutRun strong = RunCut(gamma / 20e3, false), weak = RunCut(gamma / 2e3, false);
   std::printf("Tresca vertical cut H = 1 m, gamma = 19.6 kN/m^3, t = 1.2 s: s_u = 20 kPa: max dx "
               "%.4f m, mean speed %.4f m/s, max eps_p %.4f (%.1f s); s_u = 2 kPa: max dx %.3f m, "
               "mean speed %.3f m/s, max eps_p %.3f (%.1f s)\n", strong.max_dx, strong.mean_speed,
@@ -813,9 +801,7 @@ TEST(TrescaCutTest, CutStandsWithStrongClayAndCollapsesWithWeakClay) {
 // gamma H / s_u = 3.2, between the two, the cut stands without a cut-off and collapses with
 // t = 0; at 2.4, below 2.67, it also stands with t = 0 (a crack opens, the block stops).
 TEST(TrescaCutTest, TensionCutoffLowersTheCriticalHeightToTheCrackedValue) {
-  const Real gamma = 2000 * 9.81;
-  const CutRun plain = RunCut(gamma / 3.2), cracked = RunCut(gamma / 3.2, ", tension_cutoff: 0");
-  const CutRun low = RunCut(gamma / 2.4, ", tension_cutoff: 0");
+  const CutRun plain = RunCut(3.2, false), cracked = RunCut(3.2, true), low = RunCut(2.4, true);
   std::printf("Tresca cut, t = 1.2 s: gamma H / s_u = 3.2: max dx %.4f m, speed %.4f m/s without a "
               "cut-off; %.3f m, %.3f m/s with t = 0; gamma H / s_u = 2.4 with t = 0: %.4f m, "
               "%.4f m/s\n", plain.max_dx, plain.mean_speed, cracked.max_dx, cracked.mean_speed,
