@@ -158,23 +158,6 @@ std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
           "or stress: false",
           body.name, mat.name, al.method == AntiLockingMethod::kNode ? "node" : "hybrid"));
   }
-  // Cell-based volumetric anti-locking on a fluid with B-splines: cell-constant strain on a
-  // three-cell stencil leaves a spurious mode; in the dam break the floor reaction grows to 26x
-  // the weight within 0.25 s (docs/antilocking.md, "Cell-based is not yet safe with B-splines").
-  for (const BodyInfo& body : m.bodies) {
-    const Material& mat = m.materials[size_t(body.material)];
-    const bool fluid = std::visit(
-        [](const auto& p) { return kIsFluid<std::decay_t<decltype(p)>>; }, mat.params);
-    if (!fluid || m.shape == ShapeFunction::kLinear || body.antilocking < 0 ||
-        size_t(body.antilocking) >= m.antilocking.size())
-      continue;
-    if (m.antilocking[size_t(body.antilocking)].method == AntiLockingMethod::kCell)
-      out.push_back(fmt::format(
-          "body '{}' (material '{}'): cell-based anti-locking on a fluid with B-spline shape "
-          "functions is unstable in flows (a dam break's floor reaction grows without bound, "
-          "docs/antilocking.md); use antilocking method: node (the fluids' default)",
-          body.name, mat.name));
-  }
   // A Mohr-Coulomb tension cut-off at or above the apex c cot(phi) never acts: the apex already
   // bounds the mean tension (materials/mohr_coulomb.h).
   for (const Material& mat : m.materials) {

@@ -28,7 +28,6 @@ expect check_mach_ok 0 'scene OK' -- "$surge" check "$src/scenes/dam_break_2d.ya
 if "$surge" check "$src/scenes/dam_break_2d.yaml" | grep -q Mach; then echo "FAIL check_mach_quiet: warned on the shipped dam break"; fail=$((fail + 1)); else echo "ok   check_mach_quiet"; pass=$((pass + 1)); fi
 expect check_mach_warn 0 'warning +materials\.water: .*Mach 0\.[0-9]+' -- "$surge" check "$src/scenes/dam_break_2d.yaml" --set materials.water.bulk_modulus=2.0e4
 expect check_node_stress_warn 0 "warning +body 'beam' \\(material 'aluminium'\\): stress averaging on node supports" -- "$surge" check "$src/scenes/cantilever_2d.yaml" --set 'materials.aluminium.antilocking={method: hybrid, stress: true}'
-expect check_cell_fluid_warn 0 "warning +body 'column' \\(material 'water'\\): cell-based anti-locking on a fluid" -- "$surge" check "$src/scenes/dam_break_2d.yaml" --set 'materials.water.antilocking={method: cell}'
 expect check_cutoff_above_apex_warn 0 'warning +materials\.sand: tension_cutoff 1000 Pa is at or above the apex' -- "$surge" check "$src/scenes/geostatic_column_2d.yaml" --set materials.sand.tension_cutoff=1000
 expect check_mach_warn_bingham 0 'warning +materials\.mud: .*Mach' -- "$surge" check "$src/scenes/mudflow_2d.yaml" --set materials.mud.bulk_modulus=1.0e3
 expect info_lists_models 0 'materials: .*j2.*newtonian_fluid' -- "$surge" info
