@@ -674,6 +674,10 @@ ResultsWriter::ResultsWriter(const std::string& out_dir, const std::string& name
           "set the file space strategy", I.h5);
   I.fapl = H5Pcreate(H5P_FILE_ACCESS);
   ConfigureFileAccess(I.fapl, I.h5);
+  // A run over an old result (--force) truncates its .h5: the old .xmf goes first, so that a
+  // kill before the first snapshot never leaves an .xmf listing snapshots the new file lacks
+  // (kill9_test).
+  if (fs::remove(I.xmf, ec); ec) throw IoError("cannot remove the old '" + I.xmf + "': " + ec.message());
   I.file = H5Fcreate(I.h5.c_str(), H5F_ACC_TRUNC, fcpl.get(), I.fapl);
   Require(I.file >= 0, "create the file", I.h5);
 
@@ -780,8 +784,10 @@ ResultsWriter::ResultsWriter(const std::string& out_dir, const std::string& name
   for (int c = 0; c < kEnergyColumns; ++c)
     TruncateSeries(I.energy, kEnergyNames[c], hsize_t(resume.energy_rows), I.h5);
   I.energy_rows = hsize_t(resume.energy_rows);
-  I.Commit();
+  // The .xmf lists only the kept snapshots before the commit removes the later ones from the
+  // disk: the kept ones are there before and after, so a kill at any point finds it consistent.
   WriteXdmf(I.xmf, fs::path(I.h5).filename().string(), I.written);
+  I.Commit();
 }
 
 ResultPosition ResultsWriter::Flush() {
