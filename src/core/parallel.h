@@ -2,7 +2,9 @@
 // decomposition where the result depends on it (deterministic reductions, STYLE H.4 / DESIGN §5).
 #pragma once
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -17,6 +19,13 @@ void ParallelFor(size_t n, size_t grain, const F& f) {
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t i = r.begin(); i != r.end(); ++i) f(i);
                     });
+}
+
+// Threads a parallel loop can use now: the arena's, capped by the run's -t limit (global_control).
+// Only work splits that leave results unchanged may depend on it.
+inline size_t WorkerThreads() {
+  return std::min(size_t(tbb::this_task_arena::max_concurrency()),
+                  tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
 
 // Number of fixed chunks used by deterministic reductions: independent of the thread count.

@@ -40,6 +40,16 @@ struct SparseGrid {
   std::vector<int32_t> particle_block;  // owner block of each particle
   std::vector<uint32_t> block_begin;    // size blocks+1: particles of block b are
   std::vector<uint32_t> sorted;         //   sorted[block_begin[b] .. block_begin[b+1])
+  // The work items of the per-particle gathers (G2P, the velocity gradient, the anti-locking
+  // gathers): runs sorted[begin .. end) of one block's particles. Blocks without particles are
+  // left out (they gathered a halo for nothing), and on more than one thread a block with more
+  // particles than a thread's share / 4 is cut into several runs, so that a small scene with a few
+  // crowded blocks keeps every thread busy. Each gather writes only its own particles, so the cut
+  // does not change any result. Set by BinParticles.
+  struct ParticleRun {
+    uint32_t block, begin, end;
+  };
+  std::vector<ParticleRun> runs;
   // --- Node layout: a block's nodes are [b * block_nodes + Local(lx, ly, lz)], lz fastest. A 3-D
   // block holds 8^3 nodes; a 2-D block only its z = 0 plane, 8^2 nodes (block_dz = 1), so a 2-D
   // grid stores and sweeps 8 times fewer nodes (performance issue: bytes per particle). The

@@ -1,5 +1,6 @@
-// G2P (Mast 2013 eq. (2.22)) and the particle velocity gradient (2.17). Each block gathers the
-// padded halo of its nodes once, then updates its particles; blocks are independent.
+// G2P (Mast 2013 eq. (2.22)) and the particle velocity gradient (2.17). Each run of a block's
+// particles (SparseGrid::runs) gathers the padded halo of the block's nodes once, then updates its
+// particles; runs are independent.
 #include <cstring>
 #include <type_traits>
 
@@ -64,14 +65,16 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
                   Particles& P, std::vector<Mat3>* velocity_gradient, std::vector<Vec3>* x_new) {
   using Pad = BlockPad<kDim, K>;
   const Real alpha = kMode == G2PMode::kFlip ? 1.0 : model.flip_ratio;
-  ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+    const SparseGrid::ParticleRun run = grid.runs[r];
+    const size_t blk = run.block;
     // Linear APIC also reads v_{i,n} (the affine increment below).
     using Node =
         std::conditional_t<kMode == G2PMode::kApic && !kApicUsesGradient<K>, NodeV1, NodeV01>;
     thread_local std::vector<Node> halo;
     GatherHalos<kDim, K>(grid, blk, halo);
     const Vec3i origin = grid.block_origin[blk];
-    for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
+    for (uint32_t s = run.begin; s < run.end; ++s) {
       const uint32_t p = grid.sorted[s];
       const Node* field_halo = halo.data();
       if (grid.field_count > 0) field_halo += size_t(model.body_field[P.body[p]]) * Pad::kSize;
@@ -240,12 +243,14 @@ template <int kDim, class K>
 void GradientBlocks(const StepContext& ctx, const SparseGrid& grid, const Particles& P,
                     std::vector<Mat3>& velocity_gradient) {
   using Pad = BlockPad<kDim, K>;
-  ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+    const SparseGrid::ParticleRun run = grid.runs[r];
+    const size_t blk = run.block;
     thread_local std::vector<NodeV1> halo;
     halo.resize(Pad::kSize);  // MUSL: single field only (the scene builder refuses body contacts)
     GatherHalo<kDim, K>(grid, blk, grid.velocity_new.data(), grid.velocity.data(), halo.data());
     const Vec3i origin = grid.block_origin[blk];
-    for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
+    for (uint32_t s = run.begin; s < run.end; ++s) {
       const uint32_t p = grid.sorted[s];
       Stencil<kDim, K> st;
       st.Compute(P.x[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));

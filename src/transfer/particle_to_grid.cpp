@@ -1,8 +1,6 @@
 // P2G (Mast 2013 eq. (2.12)): mass, momentum (+ APIC affine term), internal and traction forces.
 // Blocks are processed colour by colour; a block accumulates its particles into a padded local
 // buffer and adds it into itself and its 7 upper neighbours (no atomics, fixed summation order).
-#include <tbb/global_control.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <type_traits>
@@ -223,9 +221,7 @@ template <int kDim, class K, bool kApic, bool kFull, bool kFields>
 void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& grid,
              const int* body_field) {
   using Pad = BlockPad<kDim, K>;
-  const size_t threads = std::min(
-      size_t(tbb::this_task_arena::max_concurrency()),
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  const size_t threads = WorkerThreads();
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
     // A colour with few blocks (small runs: a 1e4-particle column has one or two per colour)

@@ -104,6 +104,21 @@ void BinParticles(SparseGrid& grid) {
   std::vector<uint32_t>& cursor = grid.chunk_cursor;
   cursor.assign(grid.block_begin.begin(), grid.block_begin.end() - 1);
   for (size_t p = 0; p < n; ++p) grid.sorted[cursor[grid.particle_block[p]]++] = uint32_t(p);
+
+  // Gather work items: one run per non-empty block, cut on several threads into runs of at most
+  // about a quarter of a thread's share (never below 256 particles: each run gathers its block's
+  // node halo once).
+  const size_t threads = WorkerThreads();
+  const size_t cap = threads <= 1 ? n + 1 : std::max<size_t>(256, n / (4 * threads) + 1);
+  grid.runs.clear();
+  for (size_t b = 0; b < nb; ++b) {
+    const uint32_t begin = grid.block_begin[b], count = grid.block_begin[b + 1] - begin;
+    if (count == 0) continue;
+    const uint32_t pieces = uint32_t((count + cap - 1) / cap);
+    for (uint32_t i = 0; i < pieces; ++i)
+      grid.runs.push_back({uint32_t(b), begin + uint32_t(uint64_t(count) * i / pieces),
+                           begin + uint32_t(uint64_t(count) * (i + 1) / pieces)});
+  }
 }
 
 }  // namespace surge

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+
+#include "core/parallel.h"
 #include "support/test_state.h"
 
 namespace surge {
@@ -106,6 +109,55 @@ TEST(TransferTest, ParticleToGridIsBitwiseIndependentOfThreadCount) {
   ASSERT_EQ(mass[0].size(), mass[1].size());
   EXPECT_TRUE(mass[0] == mass[1]);
   EXPECT_TRUE(force[0] == force[1]);
+}
+
+
+// The gathers' work items (SparseGrid::runs) cover every binned particle once, in block order,
+// without empty runs; on 2 threads a crowded block is cut so that no run exceeds the cap; and
+// G2P's result does not depend on the cut.
+TEST(TransferTest, GatherRunsCoverEveryParticleAndGridToParticleIgnoresTheCut) {
+  Model m = testing::SmallModel(3, ShapeFunction::kQuadraticBspline, TransferScheme::kApic, 0.05);
+  const State start = testing::RandomState(3, 20000, Vec3(0.3, 0.2, 0.1), 0.4, m.dx);
+  const StepContext ctx = Context(m);
+  std::vector<Vec3> v[2], x[2];
+  std::vector<Mat3> C[2];
+  size_t runs[2] = {0, 0};
+  bool two_threads = false;
+  for (int t = 0; t < 2; ++t) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, t + 1);
+    State s = start;
+    SparseGrid grid;
+    RebuildGrid(m, s.particles, grid);
+    const size_t n = s.particles.size();
+    size_t next = 0, largest = 0;
+    for (const SparseGrid::ParticleRun& r : grid.runs) {
+      ASSERT_EQ(r.begin, next);
+      ASSERT_LT(r.begin, r.end);
+      ASSERT_GE(r.begin, grid.block_begin[r.block]);
+      ASSERT_LE(r.end, grid.block_begin[r.block + 1]);
+      largest = std::max<size_t>(largest, r.end - r.begin);
+      next = r.end;
+    }
+    EXPECT_EQ(next, n);
+    runs[t] = grid.runs.size();
+    two_threads = t == 1 && WorkerThreads() == 2;
+    if (two_threads) {
+      EXPECT_LE(largest, std::max<size_t>(256, n / 8 + 1));
+    }
+    ParticleToGrid(m, ctx, s.particles, grid);
+    WallReport walls;
+    UpdateGridVelocity(m, ctx, grid, walls);
+    GridToParticle(m, ctx, grid, s.particles, nullptr, nullptr);
+    v[t] = s.particles.v;
+    x[t] = s.particles.x;
+    C[t] = s.particles.C;
+  }
+  if (two_threads) {
+    EXPECT_GT(runs[1], runs[0]);  // the 2-thread grid cuts its crowded blocks
+  }
+  EXPECT_TRUE(v[0] == v[1]);
+  EXPECT_TRUE(x[0] == x[1]);
+  EXPECT_TRUE(C[0] == C[1]);
 }
 
 }  // namespace
