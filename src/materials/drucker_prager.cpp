@@ -32,10 +32,15 @@ Real DruckerPragerYield(const DruckerPragerParams& p, const Mat3& tau, const His
 
 void PlasticUpdate(const DruckerPragerParams& p, const Mat3& f, Real J, Mat3& elastic_b,
                    History& h, Mat3& stress) {
-  const Real K = p.bulk_modulus, G = p.shear_modulus;
+  const HenckyTrial t = HenckyTrialState(p.bulk_modulus, p.shear_modulus, f, elastic_b);
+  PlasticUpdate(p, f, t, J, elastic_b, h, stress);
+}
+
+void PlasticUpdate(const DruckerPragerParams& p, const Mat3& f, const HenckyTrial& t, Real J,
+                   Mat3& elastic_b, History& h, Mat3& stress) {
+  const Real K = p.bulk_modulus, G = p.shear_modulus;  // t: Table 3.4, steps 1-4
   const Real H = p.kinematic_hardening, k = p.isotropic_hardening;
   const Real rho_f = p.friction_slope, rho_g = p.dilation_slope;
-  const HenckyTrial t = HenckyTrialState(K, G, f, elastic_b);  // Table 3.4, steps 1-4
   const Mat3& Q = t.Q;
   const Real I1 = t.tau.sum();
   const Vec3 s_trial = (t.tau.array() - I1 / 3.0).matrix();

@@ -9,6 +9,8 @@
 
 namespace surge {
 
+struct HenckyTrial;  // materials/hencky.h
+
 // History slots: the J2 layout (materials/j2.h) —
 //   [0]      alpha, equivalent plastic strain sum sqrt(2/3) dgamma_1 [-]
 //   [1 .. 6] back stress beta (Kirchhoff, deviatoric), xx yy zz xy yz xz [Pa]
@@ -18,6 +20,9 @@ inline constexpr int kDpHistorySlots = 8;  // slots used
 
 void PlasticUpdate(const DruckerPragerParams& params, const Mat3& f, Real J, Mat3& elastic_b,
                    History& history, Mat3& stress);
+// The same from the trial state t = HenckyTrialState(K, G, f, elastic_b) computed by the caller.
+void PlasticUpdate(const DruckerPragerParams& params, const Mat3& f, const HenckyTrial& t, Real J,
+                   Mat3& elastic_b, History& history, Mat3& stress);
 
 // Cone yield function F1 at the Kirchhoff stress tau with the stored hardening [Pa] (3.84).
 Real DruckerPragerYield(const DruckerPragerParams& params, const Mat3& tau,

@@ -7,9 +7,11 @@
 
 namespace surge {
 
-HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_b) {
-  // b^e_tr = f b^e_n f^T (3.35): with b^e_n symmetric the result is, so only its 6 distinct
-  // entries are formed (rows of f b^e_n dotted with rows of f).
+namespace {
+
+// b^e_tr = f b^e_n f^T (3.35): with b^e_n symmetric the result is, so only its 6 distinct
+// entries are formed (rows of f b^e_n dotted with rows of f).
+Mat3 TrialB(const Mat3& f, const Mat3& elastic_b) {
   const Mat3 fb = f * elastic_b;
   const Vec3 f0 = f.row(0).transpose(), f1 = f.row(1).transpose(), f2 = f.row(2).transpose();
   const Vec3 a0 = fb.row(0).transpose(), a1 = fb.row(1).transpose();
@@ -19,13 +21,34 @@ HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_
   b_trial << b00, b01, b02,  //
       b01, b11, b12,         //
       b02, b12, b22;
-  HenckyTrial t;
-  t.b = b_trial;
-  Vec3 b_principal;
-  SymmetricEigen(b_trial, b_principal, t.Q);  // Table 3.4, step 2
-  t.eps = 0.5 * b_principal.array().log();    // (3.34), erratum 2
+  return b_trial;
+}
+
+// Steps 3-4 of Table 3.4 from the decomposition of b^e_tr (step 2).
+void TrialFromPrincipal(Real K, Real G, const Vec3& b_principal, HenckyTrial& t) {
+  t.eps = 0.5 * b_principal.array().log();  // (3.34), erratum 2
   t.tau = HenckyStress(K, G, t.eps);
+}
+
+}  // namespace
+
+HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_b) {
+  HenckyTrial t;
+  t.b = TrialB(f, elastic_b);
+  Vec3 b_principal;
+  SymmetricEigen(t.b, b_principal, t.Q);  // Table 3.4, step 2
+  TrialFromPrincipal(K, G, b_principal, t);
   return t;
+}
+
+void HenckyTrialStates(Real K, Real G, const Mat3& f0, const Mat3& elastic_b0, const Mat3& f1,
+                       const Mat3& elastic_b1, HenckyTrial& t0, HenckyTrial& t1) {
+  t0.b = TrialB(f0, elastic_b0);
+  t1.b = TrialB(f1, elastic_b1);
+  Vec3 b0, b1;
+  SymmetricEigen2(t0.b, t1.b, b0, t0.Q, b1, t1.Q);  // Table 3.4, step 2
+  TrialFromPrincipal(K, G, b0, t0);
+  TrialFromPrincipal(K, G, b1, t1);
 }
 
 Vec3 HenckyStress(Real K, Real G, const Vec3& eps) {

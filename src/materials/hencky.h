@@ -22,6 +22,10 @@ struct HenckyTrial {
 
 // Steps 1-4 of Table 3.4. Pre: det f > 0, b^e_n symmetric positive definite.
 HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_b);
+// The same for two particles of one material, each bitwise equal to HenckyTrialState: the two
+// spectral decompositions run side by side (SymmetricEigen2).
+void HenckyTrialStates(Real K, Real G, const Mat3& f0, const Mat3& elastic_b0, const Mat3& f1,
+                       const Mat3& elastic_b1, HenckyTrial& t0, HenckyTrial& t1);
 
 // Principal Kirchhoff stress of principal Hencky strains: tau_i = K tr(eps) + 2G (eps_i - tr/3)
 // ([C^e_d], spec §2.0, with the factor 2 of erratum 1).

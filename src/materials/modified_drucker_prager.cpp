@@ -40,8 +40,13 @@ void InitialPlasticHistory(const ModifiedDruckerPragerParams& p, const Mat3& str
 
 void PlasticUpdate(const ModifiedDruckerPragerParams& p, const Mat3& f, Real J, Mat3& elastic_b,
                    History& h, Mat3& stress) {
-  const Real K = p.bulk_modulus, G = p.shear_modulus;
-  const HenckyTrial t = HenckyTrialState(K, G, f, elastic_b);  // Table 3.4, steps 1-4
+  const HenckyTrial t = HenckyTrialState(p.bulk_modulus, p.shear_modulus, f, elastic_b);
+  PlasticUpdate(p, f, t, J, elastic_b, h, stress);
+}
+
+void PlasticUpdate(const ModifiedDruckerPragerParams& p, const Mat3&, const HenckyTrial& t,
+                   Real J, Mat3& elastic_b, History& h, Mat3& stress) {
+  const Real K = p.bulk_modulus, G = p.shear_modulus;  // t: Table 3.4, steps 1-4
   // Frozen angles of the step (semi-implicit, Tu et al. 2009).
   const Real phi = Radians(h[kMdpFriction]);
   const Real rho_f = DruckerPragerSlope(phi);                       // (3.107)

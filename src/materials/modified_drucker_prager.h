@@ -10,6 +10,8 @@
 
 namespace surge {
 
+struct HenckyTrial;  // materials/hencky.h
+
 // History slots of a modified Drucker-Prager particle:
 //   [kMdpLambda]       lambda, plastic deformation measure sum dgamma (3.116), deviatoric norm
 //                      (spec [REC]); also the equivalent plastic strain of results (slot 0) [-]
@@ -24,6 +26,9 @@ inline constexpr int kMdpHistorySlots = 4;  // slots used
 
 void PlasticUpdate(const ModifiedDruckerPragerParams& params, const Mat3& f, Real J,
                    Mat3& elastic_b, History& history, Mat3& stress);
+// The same from the trial state t = HenckyTrialState(K, G, f, elastic_b) computed by the caller.
+void PlasticUpdate(const ModifiedDruckerPragerParams& params, const Mat3& f, const HenckyTrial& t,
+                   Real J, Mat3& elastic_b, History& history, Mat3& stress);
 
 // Angles at lambda = 0 for a start at Cauchy stress `stress` (F = I).
 void InitialPlasticHistory(const ModifiedDruckerPragerParams& params, const Mat3& stress,

@@ -207,9 +207,13 @@ McReturn MohrCoulombOnlyReturn(const McSurface& s, Real K, Real G, const Vec3& t
 
 void MohrCoulombUpdate(const McSurface& s, Real K, Real G, const Mat3& f, Real J,
                        Mat3& elastic_b, History& h, Mat3& stress) {
-  // Trial b^e_tr = f b^e_n f^T, principal Hencky strains and Kirchhoff stresses (Table 3.4,
+  MohrCoulombUpdate(s, K, G, HenckyTrialState(K, G, f, elastic_b), J, elastic_b, h, stress);
+}
+
+void MohrCoulombUpdate(const McSurface& s, Real K, Real G, const HenckyTrial& t, Real J,
+                       Mat3& elastic_b, History& h, Mat3& stress) {
+  // t: trial b^e_tr = f b^e_n f^T, principal Hencky strains and Kirchhoff stresses (Table 3.4,
   // steps 1-4). The eigen-solver leaves them unordered: sort through a permutation.
-  const HenckyTrial t = HenckyTrialState(K, G, f, elastic_b);
   std::array<int, 3> order = {0, 1, 2};
   std::sort(order.begin(), order.end(), [&](int i, int j) { return t.tau[i] > t.tau[j]; });
   const Vec3 sorted(t.tau[order[0]], t.tau[order[1]], t.tau[order[2]]);

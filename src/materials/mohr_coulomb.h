@@ -15,6 +15,8 @@
 
 namespace surge {
 
+struct HenckyTrial;  // materials/hencky.h
+
 // History slots (Particles::history) of a Mohr-Coulomb or Tresca particle:
 //   [kMcPlasticStrain]      equivalent plastic strain sum sqrt(2/3 d_eps^p : d_eps^p) [-], with
 //                           d_eps^p = eps_tr - eps_e the principal plastic Hencky increment of a
@@ -70,6 +72,9 @@ McReturn MohrCoulombReturn(const McSurface& surface, Real K, Real G, const Vec3&
 // 0 <= psi <= phi < 90 deg, c >= 0 (s_u > 0 for Tresca).
 void MohrCoulombUpdate(const McSurface& surface, Real K, Real G, const Mat3& f, Real J,
                        Mat3& elastic_b, History& history, Mat3& stress);
+// The same from the trial state t = HenckyTrialState(K, G, f, elastic_b) computed by the caller.
+void MohrCoulombUpdate(const McSurface& surface, Real K, Real G, const HenckyTrial& t, Real J,
+                       Mat3& elastic_b, History& history, Mat3& stress);
 
 inline void PlasticUpdate(const MohrCoulombParams& params, const Mat3& f, Real J,
                           Mat3& elastic_b, History& history, Mat3& stress) {
@@ -79,6 +84,16 @@ inline void PlasticUpdate(const MohrCoulombParams& params, const Mat3& f, Real J
 inline void PlasticUpdate(const TrescaParams& params, const Mat3& f, Real J, Mat3& elastic_b,
                           History& history, Mat3& stress) {
   MohrCoulombUpdate(SurfaceOf(params), params.bulk_modulus, params.shear_modulus, f, J, elastic_b,
+                    history, stress);
+}
+inline void PlasticUpdate(const MohrCoulombParams& params, const Mat3&, const HenckyTrial& t,
+                          Real J, Mat3& elastic_b, History& history, Mat3& stress) {
+  MohrCoulombUpdate(SurfaceOf(params), params.bulk_modulus, params.shear_modulus, t, J, elastic_b,
+                    history, stress);
+}
+inline void PlasticUpdate(const TrescaParams& params, const Mat3&, const HenckyTrial& t, Real J,
+                          Mat3& elastic_b, History& history, Mat3& stress) {
+  MohrCoulombUpdate(SurfaceOf(params), params.bulk_modulus, params.shear_modulus, t, J, elastic_b,
                     history, stress);
 }
 

@@ -89,8 +89,13 @@ int SmoothCapReturn(const SmoothCapDruckerPragerParams& p, const Vec3& tau_trial
 
 void PlasticUpdate(const SmoothCapDruckerPragerParams& p, const Mat3& f, Real J, Mat3& elastic_b,
                    History& h, Mat3& stress) {
-  const Real K = p.bulk_modulus, G = p.shear_modulus;
-  const HenckyTrial t = HenckyTrialState(K, G, f, elastic_b);  // Table 3.4, steps 1-4
+  const HenckyTrial t = HenckyTrialState(p.bulk_modulus, p.shear_modulus, f, elastic_b);
+  PlasticUpdate(p, f, t, J, elastic_b, h, stress);
+}
+
+void PlasticUpdate(const SmoothCapDruckerPragerParams& p, const Mat3&, const HenckyTrial& t,
+                   Real J, Mat3& elastic_b, History& h, Mat3& stress) {
+  const Real K = p.bulk_modulus, G = p.shear_modulus;  // t: Table 3.4, steps 1-4
   Vec3 tau;
   const int region = SmoothCapReturn(p, t.tau, tau);
   h[kScdpRegion] = region;

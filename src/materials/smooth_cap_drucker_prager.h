@@ -11,6 +11,8 @@
 
 namespace surge {
 
+struct HenckyTrial;  // materials/hencky.h
+
 // History slots of a smooth-cap Drucker-Prager particle:
 //   [kScdpPlasticStrain]  equivalent plastic strain sum ||dev d eps^p|| [-]
 //   [kScdpPlasticVolume]  plastic volumetric strain sum tr d eps^p (dilation positive) [-]
@@ -22,6 +24,10 @@ inline constexpr int kScdpHistorySlots = 3;  // slots used
 
 void PlasticUpdate(const SmoothCapDruckerPragerParams& params, const Mat3& f, Real J,
                    Mat3& elastic_b, History& history, Mat3& stress);
+// The same from the trial state t = HenckyTrialState(K, G, f, elastic_b) computed by the caller
+// (UpdateStress decomposes two particles' trial b^e at once: SymmetricEigen2).
+void PlasticUpdate(const SmoothCapDruckerPragerParams& params, const Mat3& f, const HenckyTrial& t,
+                   Real J, Mat3& elastic_b, History& history, Mat3& stress);
 
 // Principal-space return of a trial Kirchhoff stress (exposed for tests). Returns the region
 // (0 elastic, 1 cone, 2 cap, 3 tangent ring) and writes the returned principal stresses.

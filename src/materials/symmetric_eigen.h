@@ -19,4 +19,10 @@ namespace surge {
 // Eigen::SelfAdjointEigenSolver's iterative QR on this machine (docs/benchmarks.md).
 void SymmetricEigen(const Mat3& a, Vec3& values, Mat3& vectors);
 
+// Two decompositions at once, each bitwise equal to SymmetricEigen of its matrix: the same
+// operations in the two lanes of a vector register, so two dependent chains of divisions and
+// square roots run side by side (docs/benchmarks.md, eleventh increment).
+void SymmetricEigen2(const Mat3& a0, const Mat3& a1, Vec3& values0, Mat3& vectors0, Vec3& values1,
+                     Mat3& vectors1);
+
 }  // namespace surge

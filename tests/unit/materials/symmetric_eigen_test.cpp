@@ -16,6 +16,7 @@ namespace {
 struct Worst {
   double residual = 0, orthogonality = 0, eigenvalue = 0, log_tensor = 0;
   bool ascending = true;
+  bool pair_equal = true;  // SymmetricEigen2 bitwise equal to SymmetricEigen in both lanes
 };
 
 // Q diag(ln l) Q^T.
@@ -32,11 +33,19 @@ Mat3 RandomRotation(std::mt19937& g) {
 Worst Check(int count, const std::function<Mat3(std::mt19937&)>& make) {
   std::mt19937 g(20261123);
   Worst w;
+  Mat3 previous = Mat3::Identity(), previous_q = Mat3::Identity();
+  Vec3 previous_l = Vec3::Ones();
   for (int k = 0; k < count; ++k) {
     const Mat3 a = Sym(make(g));
     Vec3 l;
     Mat3 q;
     SymmetricEigen(a, l, q);
+    // The pair form, with the previous matrix in the other lane, is bitwise the one-matrix form.
+    Vec3 l0, l1;
+    Mat3 q0, q1;
+    SymmetricEigen2(a, previous, l0, q0, l1, q1);
+    w.pair_equal = w.pair_equal && l0 == l && q0 == q && l1 == previous_l && q1 == previous_q;
+    previous = a, previous_l = l, previous_q = q;
     const double norm = a.norm();
     w.residual = std::max(w.residual, (a * q - q * l.asDiagonal()).norm() / norm);
     w.orthogonality = std::max(w.orthogonality, (q.transpose() * q - Mat3::Identity()).norm());
@@ -61,6 +70,7 @@ void ExpectAccurate(const Worst& w) {
   EXPECT_LT(w.eigenvalue, 5e-15);
   EXPECT_LT(w.log_tensor, 1e-14);
   EXPECT_TRUE(w.ascending);
+  EXPECT_TRUE(w.pair_equal);
 }
 
 std::normal_distribution<double> Normal(double sd) { return std::normal_distribution<double>(0, sd); }
@@ -120,6 +130,31 @@ TEST(SymmetricEigen, LargeStretches) {
     return Mat3(r * stretch.cwiseAbs2().asDiagonal() * r.transpose());
   });
   ExpectAccurate(w);
+}
+
+TEST(SymmetricEigen, PairEqualsSingleOnSmallIntegerMatrices) {
+  // Structured inputs: repeated roots, zero rotations (e = 0) and exactly diagonal lanes.
+  std::mt19937 g(7);
+  std::uniform_int_distribution<int> n(-2, 2);
+  int checked = 0;
+  for (int k = 0; k < 20000; ++k) {
+    Mat3 a[2];
+    for (Mat3& m : a) {
+      for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j) m(i, j) = m(j, i) = n(g);
+    }
+    Vec3 l[2], p[2];
+    Mat3 q[2], r[2];
+    SymmetricEigen(a[0], l[0], q[0]);
+    SymmetricEigen(a[1], l[1], q[1]);
+    SymmetricEigen2(a[0], a[1], p[0], r[0], p[1], r[1]);
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_EQ(p[i], l[i]) << a[i];
+      ASSERT_EQ(r[i], q[i]) << a[i];
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 20000);
 }
 
 }  // namespace
