@@ -42,14 +42,18 @@ Mat3 J2BackStressOf(const History& h) {
 // update is exactly the seed's principal-space return.
 void J2Update(const J2Params& p, const Mat3& f, Real J, Mat3& elastic_b, History& h,
               Mat3& stress) {
-  const Real K = p.bulk_modulus;
+  J2Update(p, f, HenckyTrialState(p.bulk_modulus, p.shear_modulus, f, elastic_b), J, elastic_b, h,
+           stress);
+}
+
+void J2Update(const J2Params& p, const Mat3& f, const HenckyTrial& t, Real J, Mat3& elastic_b,
+              History& h, Mat3& stress) {
   const Real G = p.shear_modulus;
   const Real H = p.kinematic_hardening;
   const Real k = p.isotropic_hardening;
 
-  // Trial b^e_tr = f b^e_n f^T, its principal Hencky strains and Kirchhoff stresses
+  // t: trial b^e_tr = f b^e_n f^T, its principal Hencky strains and Kirchhoff stresses
   // (Table 3.4, steps 1-4).
-  const HenckyTrial t = HenckyTrialState(K, G, f, elastic_b);
   const Mat3& Q = t.Q;
   const Vec3& eps = t.eps;
   const Vec3 s_trial = (t.tau.array() - t.tau.sum() / 3.0).matrix();

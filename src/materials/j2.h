@@ -7,6 +7,8 @@
 
 namespace surge {
 
+struct HenckyTrial;  // materials/hencky.h
+
 // History slots (Particles::history) of a J2 particle:
 //   [kJ2PlasticStrain]           alpha_iso, equivalent plastic strain sum sqrt(2/3) dgamma [-]
 //   [kJ2BackStress + 0 .. + 5]   back stress beta = -kappa_kin (Kirchhoff, deviatoric) [Pa],
@@ -21,9 +23,17 @@ inline constexpr int kJ2HistorySlots = 7;  // slots used: plastic strain and 6 b
 void J2Update(const J2Params& params, const Mat3& f, Real J, Mat3& elastic_b, History& history,
               Mat3& stress);
 
+// The same from the trial state t = HenckyTrialState(K, G, f, elastic_b) computed by the caller.
+void J2Update(const J2Params& params, const Mat3& f, const HenckyTrial& t, Real J, Mat3& elastic_b,
+              History& history, Mat3& stress);
+
 inline void PlasticUpdate(const J2Params& params, const Mat3& f, Real J, Mat3& elastic_b,
                           History& history, Mat3& stress) {
   J2Update(params, f, J, elastic_b, history, stress);
+}
+inline void PlasticUpdate(const J2Params& params, const Mat3& f, const HenckyTrial& t, Real J,
+                          Mat3& elastic_b, History& history, Mat3& stress) {
+  J2Update(params, f, t, J, elastic_b, history, stress);
 }
 
 // Yield function F = ||dev tau - beta|| - sqrt(2/3) (sigma_Y + k alpha_iso) [Pa] (3.69)-(3.72),

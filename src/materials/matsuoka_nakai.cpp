@@ -372,9 +372,14 @@ MatsuokaNakaiReturn MatsuokaNakaiReturnMap(const MatsuokaNakaiParams &p,
 // §2.7 step 4-5.
 void MatsuokaNakaiUpdate(const MatsuokaNakaiParams &p, const Mat3 &f, Real J,
                          Mat3 &elastic_b, History &h, Mat3 &stress) {
-  const Real K = p.bulk_modulus, G = p.shear_modulus;
-  const HenckyTrial t =
-      HenckyTrialState(K, G, f, elastic_b); // Table 3.4 steps 1-4
+  MatsuokaNakaiUpdate(
+      p, HenckyTrialState(p.bulk_modulus, p.shear_modulus, f, elastic_b), J,
+      elastic_b, h, stress);
+}
+
+void MatsuokaNakaiUpdate(const MatsuokaNakaiParams &p, const HenckyTrial &t,
+                         Real J, Mat3 &elastic_b, History &h, Mat3 &stress) {
+  const Real K = p.bulk_modulus, G = p.shear_modulus; // t: Table 3.4 steps 1-4
   const Real phi_f = h[kMnFrictionAngle], psi_g = h[kMnDilationAngle];
   if (Shifted(t.tau, p.cohesion).maxCoeff() < 0 &&
       MatsuokaNakaiFunction(MatsuokaNakaiKappa(phi_f), p.cohesion, t.tau) <=

@@ -10,6 +10,8 @@
 
 namespace surge {
 
+struct HenckyTrial;  // materials/hencky.h
+
 // History slots (Particles::history) of a Matsuoka-Nakai particle:
 //   [kMnPlasticStrain]       equivalent plastic strain sum sqrt(2/3) |dev d
 //   eps^p| [-] [kMnLambda]              lambda, plastic deformation measure sum
@@ -85,10 +87,21 @@ void MatsuokaNakaiUpdate(const MatsuokaNakaiParams &params, const Mat3 &f,
                          Real J, Mat3 &elastic_b, History &history,
                          Mat3 &stress);
 
+// The same from the trial state t = HenckyTrialState(K, G, f, elastic_b)
+// computed by the caller.
+void MatsuokaNakaiUpdate(const MatsuokaNakaiParams &params,
+                         const HenckyTrial &t, Real J, Mat3 &elastic_b,
+                         History &history, Mat3 &stress);
+
 inline void PlasticUpdate(const MatsuokaNakaiParams &params, const Mat3 &f,
                           Real J, Mat3 &elastic_b, History &history,
                           Mat3 &stress) {
   MatsuokaNakaiUpdate(params, f, J, elastic_b, history, stress);
+}
+inline void PlasticUpdate(const MatsuokaNakaiParams &params, const Mat3 &,
+                          const HenckyTrial &t, Real J, Mat3 &elastic_b,
+                          History &history, Mat3 &stress) {
+  MatsuokaNakaiUpdate(params, t, J, elastic_b, history, stress);
 }
 
 // History of a particle starting at the Cauchy stress `stress` with F = I:

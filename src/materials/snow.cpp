@@ -145,8 +145,13 @@ Real SnowCriticalStateRatio(const SnowParams& m) {
 // return keeps the trial eigenvectors and the direction of the trial deviator.
 void SnowUpdate(const SnowParams& m, const Mat3& f, Real J, Mat3& elastic_b, History& h,
                 Mat3& stress) {
-  const Real K = m.bulk_modulus, G = m.shear_modulus;
-  const HenckyTrial t = HenckyTrialState(K, G, f, elastic_b);  // Table 3.4 steps 1-4
+  SnowUpdate(m, HenckyTrialState(m.bulk_modulus, m.shear_modulus, f, elastic_b), J, elastic_b, h,
+             stress);
+}
+
+void SnowUpdate(const SnowParams& m, const HenckyTrial& t, Real J, Mat3& elastic_b, History& h,
+                Mat3& stress) {
+  const Real K = m.bulk_modulus, G = m.shear_modulus;  // t: Table 3.4 steps 1-4
   const Real p_tr = -t.tau.sum() / 3;
   const Vec3 s_tr = (t.tau.array() + p_tr).matrix();
   const Real q_tr = kSqrtThreeHalves * s_tr.norm();

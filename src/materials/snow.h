@@ -8,6 +8,8 @@
 
 namespace surge {
 
+struct HenckyTrial;  // materials/hencky.h
+
 // History slots (Particles::history) of a snow particle:
 //   [kSnowPlasticStrain]        eps_q^p, deviatoric equivalent plastic strain sum (q_tr - q)/(3G) [-]
 //   [kSnowVolumetricPlastic]    alpha = eps_v^p = ln J^p, volumetric plastic strain (tension
@@ -41,9 +43,17 @@ Real SnowCriticalStateRatio(const SnowParams& params);
 void SnowUpdate(const SnowParams& params, const Mat3& f, Real J, Mat3& elastic_b, History& history,
                 Mat3& stress);
 
+// The same from the trial state t = HenckyTrialState(K, G, f, elastic_b) computed by the caller.
+void SnowUpdate(const SnowParams& params, const HenckyTrial& t, Real J, Mat3& elastic_b,
+                History& history, Mat3& stress);
+
 inline void PlasticUpdate(const SnowParams& params, const Mat3& f, Real J, Mat3& elastic_b,
                           History& history, Mat3& stress) {
   SnowUpdate(params, f, J, elastic_b, history, stress);
+}
+inline void PlasticUpdate(const SnowParams& params, const Mat3&, const HenckyTrial& t, Real J,
+                          Mat3& elastic_b, History& history, Mat3& stress) {
+  SnowUpdate(params, t, J, elastic_b, history, stress);
 }
 
 // History of a particle starting at the Cauchy stress `stress` with F = I: p0 = p0_init, raised to
