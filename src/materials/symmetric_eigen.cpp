@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <type_traits>
 #include <utility>
 
 #if defined(__SSE2__)
@@ -158,16 +157,13 @@ void Decompose(Lanes<L>& z) {
   }
 }
 
+void Put(Real& slot, int, Real value) { slot = value; }
+void Put(Real2& slot, int lane, Real value) { slot[lane] = value; }
+
 // Loads A's symmetric part, its shift m and scale s into lane `lane` (scalar: lane 0 only).
 template <class L>
 void Load(const Mat3& a, Lanes<L>& z, int lane) {
-  const auto put = [lane](typename L::T& slot, Real value) {
-    if constexpr (std::is_same_v<L, ScalarLane>) {
-      slot = value;
-    } else {
-      slot[lane] = value;
-    }
-  };
+  const auto put = [lane](typename L::T& slot, Real value) { Put(slot, lane, value); };
   const Real m = (a(0, 0) + a(1, 1) + a(2, 2)) / 3.0;
   const Real b00 = a(0, 0) - m, b11 = a(1, 1) - m, b22 = a(2, 2) - m;
   const Real b01 = 0.5 * (a(0, 1) + a(1, 0)), b02 = 0.5 * (a(0, 2) + a(2, 0));
