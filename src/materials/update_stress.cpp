@@ -58,55 +58,42 @@ void UpdateStress(const Model& model, const StepContext& ctx,
                        P.stress[p] = NeoHookeanStress(params, P.F[p]);
                      });
                    },
-                   [&]<class Pm>(const Pm& params) {
+                   [&](const auto& params) {
                      // Elastoplastic models (Hencky elasticity, b^e, Table 3.4): each provides
-                     // PlasticUpdate(params, f, J, b^e, history, sigma) in its own header.
-                     // Those that also take the trial state from the caller get it two particles
-                     // at a time (HenckyTrialStates: two spectral decompositions side by side).
-                     // The pairs are fixed (2k, 2k+1 of the group) and each particle's result is
-                     // bitwise what the one-particle path gives, so neither the thread count nor
-                     // the pairing changes a result.
-                     if constexpr (requires(const Mat3& f, const HenckyTrial& t, Real J, Mat3& b,
-                                            History& h, Mat3& s) {
-                                     PlasticUpdate(params, f, t, J, b, h, s);
-                                   }) {
-                       const Real K = params.bulk_modulus, G = params.shear_modulus;
-                       ParallelFor((count + 1) / 2, 128, [&](size_t k) {
-                         const size_t p0 = g.begin + 2 * k, n = std::min<size_t>(2, g.end - p0);
-                         Mat3 f[2], b[2];
-                         for (size_t i = 0; i < n; ++i) {
-                           f[i] = Mat3::Identity() + dt * velocity_gradient[p0 + i];  // (2.18)
-                           P.F[p0 + i] = f[i] * P.F[p0 + i];
-                           b[i] = P.elastic_b[p0 + i];  // b^e stored as its 6 components
-                         }
-                         HenckyTrial t[2];
-                         if (n == 2) {
-                           HenckyTrialStates(K, G, f[0], b[0], f[1], b[1], t[0], t[1]);
-                         } else {
-                           t[0] = HenckyTrialState(K, G, f[0], b[0]);
-                         }
-                         for (size_t i = 0; i < n; ++i) {
-                           const size_t p = p0 + i;
-                           Mat3 stress;
-                           History h = P.history.Get(p);  // the run's slots, the rest zero
-                           PlasticUpdate(params, f[i], t[i], P.F[p].determinant(), b[i], h, stress);
-                           P.history.Set(p, h);
-                           P.elastic_b[p] = b[i];
-                           P.stress[p] = stress;
-                         }
-                       });
-                       return;
-                     }
-                     ParallelFor(count, 256, [&](size_t k) {
-                       const size_t p = g.begin + k;
-                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
-                       P.F[p] = f * P.F[p];
-                       Mat3 stress, b = P.elastic_b[p];  // b^e stored as its 6 components
-                       History h = P.history.Get(p);     // the run's slots, the rest zero
-                       PlasticUpdate(params, f, P.F[p].determinant(), b, h, stress);
-                       P.history.Set(p, h);
-                       P.elastic_b[p] = b;
-                       P.stress[p] = stress;
+                     // PlasticUpdate(params, f, trial, J, b^e, history, sigma) in its own header
+                     // and takes the trial state from here, two particles at a time
+                     // (HenckyTrialStates: two spectral decompositions side by side). The pairs
+                     // are fixed (2k, 2k+1 of the group) and each particle's result is bitwise
+                     // what the one-particle path gives, so neither the thread count nor the
+                     // pairing changes a result.
+                     static_assert(
+                         requires(const Mat3& f, const HenckyTrial& t, Real J, Mat3& b, History& h,
+                                  Mat3& s) { PlasticUpdate(params, f, t, J, b, h, s); },
+                         "an elastoplastic model must take its Hencky trial state from the caller");
+                     const Real K = params.bulk_modulus, G = params.shear_modulus;
+                     ParallelFor((count + 1) / 2, 128, [&](size_t k) {
+                       const size_t p0 = g.begin + 2 * k, n = std::min<size_t>(2, g.end - p0);
+                       Mat3 f[2], b[2];
+                       for (size_t i = 0; i < n; ++i) {
+                         f[i] = Mat3::Identity() + dt * velocity_gradient[p0 + i];  // (2.18)
+                         P.F[p0 + i] = f[i] * P.F[p0 + i];
+                         b[i] = P.elastic_b[p0 + i];  // b^e stored as its 6 components
+                       }
+                       HenckyTrial t[2];
+                       if (n == 2) {
+                         HenckyTrialStates(K, G, f[0], b[0], f[1], b[1], t[0], t[1]);
+                       } else {
+                         t[0] = HenckyTrialState(K, G, f[0], b[0]);
+                       }
+                       for (size_t i = 0; i < n; ++i) {
+                         const size_t p = p0 + i;
+                         Mat3 stress;
+                         History h = P.history.Get(p);  // the run's slots, the rest zero
+                         PlasticUpdate(params, f[i], t[i], P.F[p].determinant(), b[i], h, stress);
+                         P.history.Set(p, h);
+                         P.elastic_b[p] = b[i];
+                         P.stress[p] = stress;
+                       }
                      });
                    },
                    [&](const NewtonianFluidParams& params) {
