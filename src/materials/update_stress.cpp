@@ -23,117 +23,157 @@
 namespace surge {
 namespace {
 
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
+// sigma : sym(L) from the 6 stored components (Voigt xx yy zz xy yz xz), times J V0: the stress
+// power of one particle [W] (Mast 2013 (2.18): d = sym(L) is the rate the update uses).
+Real StressPowerOf(const SymMat3& stress, const Mat3& l, Real J, Real V0) {
+  const Real* t = stress.v;
+  const Real power = t[0] * l(0, 0) + t[1] * l(1, 1) + t[2] * l(2, 2) + t[3] * (l(0, 1) + l(1, 0)) +
+                     t[4] * (l(1, 2) + l(2, 1)) + t[5] * (l(0, 2) + l(2, 0));
+  return J * V0 * power;
+}
+
+// One particle's step from its L_p (Mast 2013 (2.18)-(2.20)) for the non-Hencky models: F_{n+1} =
+// (I + dt L) F_n, then the model's stress. Hencky models go through UpdateSpan's pairs instead.
+template <class Pm>
+void UpdateOne(const Pm& params, Real dt, size_t p, const Mat3& L, Particles& P) {
+  const Mat3 f = Mat3::Identity() + dt * L;  // (2.18)
+  P.F[p] = f * P.F[p];
+  if constexpr (std::is_same_v<Pm, LinearElasticParams>) {
+    Mat3 stress = P.stress[p];
+    LinearElasticUpdate(params, Sym(f - Mat3::Identity()), stress, P.strain[p]);
+    P.stress[p] = stress;
+  } else if constexpr (std::is_same_v<Pm, NeoHookeanParams>) {
+    P.stress[p] = NeoHookeanStress(params, P.F[p]);
+  } else if constexpr (std::is_same_v<Pm, NewtonianFluidParams>) {
+    P.stress[p] = NewtonianFluidStress(params, P.F[p].determinant(), L);  // (6.1)-(6.2)
+  } else {
+    static_assert(std::is_same_v<Pm, BinghamFluidParams> || std::is_same_v<Pm, FrictionalFluidParams>);
+    Mat3 stress;
+    History h = P.history.Get(p);
+    if constexpr (std::is_same_v<Pm, BinghamFluidParams>)
+      BinghamFluidUpdate(params, P.F[p].determinant(), L, dt, h, stress);  // A3D (7.37)
+    else
+      FrictionalFluidUpdate(params, P.F[p].determinant(), L, dt, h, stress);  // A3D (7.38)
+    P.history.Set(p, h);
+    P.stress[p] = stress;
+  }
+}
+
+// The step of particles index(k), k in [k_begin, k_end), all of one material, with gradients
+// grad(k); with `energy` returns the sum of their stress powers P_n + P_{n+1} in k order, else 0.
+// Elastoplastic models (Hencky elasticity, b^e, Table 3.4) provide PlasticUpdate(params, f, trial,
+// J, b^e, history, sigma) in their own headers and take the trial state from here, two particles
+// at a time (HenckyTrialStates: two spectral decompositions side by side). Each particle's result
+// is bitwise what the one-particle path gives, so neither the thread count, the split into spans
+// nor the pairing changes a result.
+template <class Pm, class Index, class Grad>
+Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const Index& index,
+                const Grad& grad, Particles& P, bool energy) {
+  // P_n of particle p, read before its update (F_n, sigma_n), or P_{n+1} after it.
+  const auto power_of = [&](size_t p, const Mat3& L, Real J) {
+    return energy ? StressPowerOf(P.stress[p], L, J, P.volume0[p]) : 0.0;
+  };
+  Real sum = 0;
+  if constexpr (kIsElastoplastic<Pm>) {
+    static_assert(
+        requires(const Mat3& f, const HenckyTrial& t, Real J, Mat3& b, History& h, Mat3& s) {
+          PlasticUpdate(params, f, t, J, b, h, s);
+        },
+        "an elastoplastic model must take its Hencky trial state from the caller");
+    const Real K = params.bulk_modulus, G = params.shear_modulus;
+    for (size_t k0 = k_begin; k0 < k_end; k0 += 2) {
+      const size_t n = std::min<size_t>(2, k_end - k0);
+      size_t p[2];
+      Mat3 f[2], b[2];
+      Real before[2] = {0, 0};
+      for (size_t i = 0; i < n; ++i) {
+        p[i] = index(k0 + i);
+        const Mat3& L = grad(k0 + i);
+        if (energy) before[i] = power_of(p[i], L, P.F[p[i]].determinant());
+        f[i] = Mat3::Identity() + dt * L;  // (2.18)
+        P.F[p[i]] = f[i] * P.F[p[i]];
+        b[i] = P.elastic_b[p[i]];  // b^e stored as its 6 components
+      }
+      HenckyTrial t[2];
+      if (n == 2) {
+        HenckyTrialStates(K, G, f[0], b[0], f[1], b[1], t[0], t[1]);
+      } else {
+        t[0] = HenckyTrialState(K, G, f[0], b[0]);
+      }
+      for (size_t i = 0; i < n; ++i) {
+        Mat3 stress;
+        History h = P.history.Get(p[i]);  // the run's slots, the rest zero
+        const Real J = P.F[p[i]].determinant();
+        PlasticUpdate(params, f[i], t[i], J, b[i], h, stress);
+        P.history.Set(p[i], h);
+        P.elastic_b[p[i]] = b[i];
+        P.stress[p[i]] = stress;
+        if (energy) sum += before[i] + power_of(p[i], grad(k0 + i), J);
+      }
+    }
+  } else {
+    for (size_t k = k_begin; k < k_end; ++k) {
+      const size_t p = index(k);
+      const Mat3& L = grad(k);
+      const Real before = energy ? power_of(p, L, P.F[p].determinant()) : 0.0;
+      UpdateOne(params, dt, p, L, P);
+      if (energy) sum += before + power_of(p, L, P.F[p].determinant());
+    }
+  }
+  return sum;
+}
 
 }  // namespace
 
 void UpdateStress(const Model& model, const StepContext& ctx,
                   const std::vector<Mat3>& velocity_gradient,
-                  const std::vector<MaterialGroup>& groups, Particles& P) {
+                  const std::vector<MaterialGroup>& groups, Particles& P, Real* stress_power) {
   const Real dt = ctx.dt;
+  const bool energy = stress_power != nullptr;
+  if (energy) *stress_power = 0;
   for (const MaterialGroup& g : groups) {
     const size_t count = g.end - g.begin;
-    std::visit(Overloaded{
-                   [&](const LinearElasticParams& params) {
-                     ParallelFor(count, 1024, [&](size_t k) {
-                       const size_t p = g.begin + k;
-                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
-                       P.F[p] = f * P.F[p];
-                       Mat3 stress = P.stress[p];
-                       LinearElasticUpdate(params, Sym(f - Mat3::Identity()), stress,
-                                           P.strain[p]);
-                       P.stress[p] = stress;
-                     });
-                   },
-                   [&](const NeoHookeanParams& params) {
-                     ParallelFor(count, 1024, [&](size_t k) {
-                       const size_t p = g.begin + k;
-                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
-                       P.F[p] = f * P.F[p];
-                       P.stress[p] = NeoHookeanStress(params, P.F[p]);
-                     });
-                   },
-                   [&](const auto& params) {
-                     // Elastoplastic models (Hencky elasticity, b^e, Table 3.4): each provides
-                     // PlasticUpdate(params, f, trial, J, b^e, history, sigma) in its own header
-                     // and takes the trial state from here, two particles at a time
-                     // (HenckyTrialStates: two spectral decompositions side by side). The pairs
-                     // are fixed (2k, 2k+1 of the group) and each particle's result is bitwise
-                     // what the one-particle path gives, so neither the thread count nor the
-                     // pairing changes a result.
-                     static_assert(
-                         requires(const Mat3& f, const HenckyTrial& t, Real J, Mat3& b, History& h,
-                                  Mat3& s) { PlasticUpdate(params, f, t, J, b, h, s); },
-                         "an elastoplastic model must take its Hencky trial state from the caller");
-                     const Real K = params.bulk_modulus, G = params.shear_modulus;
-                     ParallelFor((count + 1) / 2, 128, [&](size_t k) {
-                       const size_t p0 = g.begin + 2 * k, n = std::min<size_t>(2, g.end - p0);
-                       Mat3 f[2], b[2];
-                       for (size_t i = 0; i < n; ++i) {
-                         f[i] = Mat3::Identity() + dt * velocity_gradient[p0 + i];  // (2.18)
-                         P.F[p0 + i] = f[i] * P.F[p0 + i];
-                         b[i] = P.elastic_b[p0 + i];  // b^e stored as its 6 components
-                       }
-                       HenckyTrial t[2];
-                       if (n == 2) {
-                         HenckyTrialStates(K, G, f[0], b[0], f[1], b[1], t[0], t[1]);
-                       } else {
-                         t[0] = HenckyTrialState(K, G, f[0], b[0]);
-                       }
-                       for (size_t i = 0; i < n; ++i) {
-                         const size_t p = p0 + i;
-                         Mat3 stress;
-                         History h = P.history.Get(p);  // the run's slots, the rest zero
-                         PlasticUpdate(params, f[i], t[i], P.F[p].determinant(), b[i], h, stress);
-                         P.history.Set(p, h);
-                         P.elastic_b[p] = b[i];
-                         P.stress[p] = stress;
-                       }
-                     });
-                   },
-                   [&](const NewtonianFluidParams& params) {
-                     ParallelFor(count, 1024, [&](size_t k) {
-                       const size_t p = g.begin + k;
-                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
-                       P.F[p] = f * P.F[p];
-                       P.stress[p] = NewtonianFluidStress(params, P.F[p].determinant(),
-                                                          velocity_gradient[p]);  // (6.1)-(6.2)
-                     });
-                   },
-                   [&](const BinghamFluidParams& params) {
-                     ParallelFor(count, 1024, [&](size_t k) {
-                       const size_t p = g.begin + k;
-                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
-                       P.F[p] = f * P.F[p];
-                       Mat3 stress;
-                       History h = P.history.Get(p);
-                       BinghamFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p], dt,
-                                          h, stress);  // A3D (7.37)
-                       P.history.Set(p, h);
-                       P.stress[p] = stress;
-                     });
-                   },
-                   [&](const FrictionalFluidParams& params) {
-                     ParallelFor(count, 1024, [&](size_t k) {
-                       const size_t p = g.begin + k;
-                       const Mat3 f = Mat3::Identity() + dt * velocity_gradient[p];  // (2.18)
-                       P.F[p] = f * P.F[p];
-                       Mat3 stress;
-                       History h = P.history.Get(p);
-                       FrictionalFluidUpdate(params, P.F[p].determinant(), velocity_gradient[p],
-                                             dt, h, stress);  // A3D (7.38)
-                       P.history.Set(p, h);
-                       P.stress[p] = stress;
-                     });
-                   },
-               },
-               model.materials[g.material].params);
+    std::visit(
+        [&](const auto& params) {
+          const auto index = [&](size_t k) { return g.begin + k; };
+          const auto grad = [&](size_t k) -> const Mat3& { return velocity_gradient[g.begin + k]; };
+          if (!energy) {
+            // Spans of 256 (Hencky models, in pairs) or 1024 particles.
+            const size_t grain = kIsElastoplastic<std::decay_t<decltype(params)>> ? 256 : 1024;
+            ParallelFor((count + grain - 1) / grain, 1, [&](size_t c) {
+              UpdateSpan(params, dt, c * grain, std::min(count, (c + 1) * grain), index, grad, P,
+                         false);
+            });
+            return;
+          }
+          // With the stress power: fixed chunks, summed in chunk order (any thread count).
+          std::array<Real, kReductionChunks> partial{};
+          ParallelChunks(count, [&](size_t c, size_t b, size_t e) {
+            partial[c] = UpdateSpan(params, dt, b, e, index, grad, P, true);
+          });
+          for (Real v : partial) *stress_power += v;
+        },
+        model.materials[g.material].params);
   }
+}
+
+Real UpdateStressOfRun(const Model& model, const StepContext& ctx, const uint32_t* ids,
+                       const Mat3* velocity_gradient, size_t n, Particles& P, bool energy) {
+  Real sum = 0;
+  const auto index = [&](size_t k) { return size_t(ids[k]); };
+  const auto grad = [&](size_t k) -> const Mat3& { return velocity_gradient[k]; };
+  for (size_t begin = 0; begin < n;) {  // spans of one material, in run order
+    const int32_t material = P.material[ids[begin]];
+    size_t end = begin + 1;
+    while (end < n && P.material[ids[end]] == material) ++end;
+    sum += std::visit(
+        [&](const auto& params) {
+          return UpdateSpan(params, ctx.dt, begin, end, index, grad, P, energy);
+        },
+        model.materials[size_t(material)].params);
+    begin = end;
+  }
+  return sum;
 }
 
 namespace {

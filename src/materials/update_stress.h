@@ -11,10 +11,20 @@ namespace surge {
 
 // F_{n+1} = (I + dt L) F_n (2.18), then the group's constitutive update. Reads L, F, stress and
 // what the group's model keeps (linear_elastic: strain; plastic models: elastic_b, history; yield-
-// stress fluids: history), writes F, stress and that state.
+// stress fluids: history), writes F, stress and that state. With `stress_power` non-null it is
+// set to P_n + P_{n+1}, P = sum_p J_p V0_p sigma_p : sym(L_p) [W] before and after the update
+// (the energy record's internal work, docs/stability.md), summed in fixed chunks.
 void UpdateStress(const Model& model, const StepContext& ctx,
                   const std::vector<Mat3>& velocity_gradient,
-                  const std::vector<MaterialGroup>& groups, Particles& particles);
+                  const std::vector<MaterialGroup>& groups, Particles& particles,
+                  Real* stress_power = nullptr);
+
+// The same update for the particles ids[0..n) with gradients velocity_gradient[0..n) (one run of
+// G2P: the step fuses the stress update into G2P where nothing else reads L, docs/architecture.md).
+// Particles may belong to different materials. With `energy` returns their P_n + P_{n+1} [W],
+// summed in k order; else 0.
+Real UpdateStressOfRun(const Model& model, const StepContext& ctx, const uint32_t* ids,
+                       const Mat3* velocity_gradient, size_t n, Particles& particles, bool energy);
 
 // Material history consistent with a prescribed initial Cauchy stress at F = I (a geostatic
 // start): b^e from the elastic compliance for J2, identity otherwise; history slots zero.

@@ -92,14 +92,16 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, const std::vector<
       Stencil<kDim, K> st;
       st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
       const Vec3i lb = st.base - origin;
+      // N_ip = w_i w_j w_c (tensor product): the (i, j) factors times m and m q once per row.
       for (int i = 0; i < st.W; ++i)
-        for (int j = 0; j < st.W; ++j)
+        for (int j = 0; j < st.W; ++j) {
+          const Real wxy = st.w[0][i] * st.w[1][j], wm = wxy * m, wmq = wxy * mq;
+          Accum* row = &buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
           for (int c = 0; c < st.Wz; ++c) {
-            const Real w = st.Weight(i, j, c);
-            Accum& a = buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)];
-            a.w += w * m;
-            a.wq += w * mq;
+            row[c].w += st.w[2][c] * wm;
+            row[c].wq += st.w[2][c] * wmq;
           }
+        }
     } else {
       Vec3i cell = Vec3i::Zero();
       for (int d = 0; d < kDim; ++d) cell[d] = int(std::floor(x_n[p][d] * ctx.inv_dx));

@@ -115,6 +115,24 @@ void GridToParticleUslStage(const Model& m, const StepContext& c, State& s, Work
   GridToParticle(m, c, w.grid, s.particles, &w.velocity_gradient, nullptr);
 }
 
+void GridToParticleStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                               StepReport&) {
+  // The internal work of UpdateStressStage, W += dt/2 (P_n + P_{n+1}), from each run's sum, added
+  // in run order (the runs depend on the grid only, not on the thread count).
+  const bool energy = m.output.energy;
+  w.run_power.assign(energy ? w.grid.runs.size() : 0, 0.0);
+  const GradientSink sink = [&](size_t run, const uint32_t* ids, const Mat3* L, size_t n) {
+    const Real power = UpdateStressOfRun(m, c, ids, L, n, s.particles, energy);  // (2.18)-(2.20)
+    if (energy) w.run_power[run] = power;
+  };
+  GridToParticle(m, c, w.grid, s.particles, nullptr, nullptr, &sink);
+  if (energy) {
+    Real total = 0;
+    for (Real power : w.run_power) total += power;
+    s.internal_work += 0.5 * c.dt * total;
+  }
+}
+
 void GridToParticleMuslStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                              StepReport&) {
   GridToParticle(m, c, w.grid, s.particles, nullptr, &w.x_new);
@@ -154,36 +172,15 @@ void StressAveragingStage(const Model& m, const StepContext& c, State& s, Worksp
   ProjectStress(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking);
 }
 
-// Stress power sum_p J_p V0_p sigma_p : sym(L_p) [W], in fixed chunks (deterministic).
-static Real StressPower(const Particles& P, const std::vector<Mat3>& L) {
-  std::array<Real, kReductionChunks> partial{};
-  ParallelChunks(P.size(), [&](size_t c, size_t b, size_t e) {
-    Real sum = 0;
-    for (size_t p = b; p < e; ++p) {
-      // sigma : sym(L) from the 6 stored components (Voigt xx yy zz xy yz xz).
-      const Real* t = P.stress[p].v;
-      const Mat3& l = L[p];
-      const Real power = t[0] * l(0, 0) + t[1] * l(1, 1) + t[2] * l(2, 2) +
-                         t[3] * (l(0, 1) + l(1, 0)) + t[4] * (l(1, 2) + l(2, 1)) +
-                         t[5] * (l(0, 2) + l(2, 0));
-      sum += P.F[p].determinant() * P.volume0[p] * power;
-    }
-    partial[c] = sum;
-  });
-  Real total = 0;
-  for (Real v : partial) total += v;
-  return total;
-}
-
 void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                        StepReport&) {
   // Internal work for the energy balance (docs/stability.md, "Energy"): the trapezoid rule on
   // the stress power over the step, W += dt/2 (P_n + P_{n+1}), P = sum V sigma : d with the
-  // rate of deformation d = sym(L) that the stress update uses (Mast 2013 (2.18)).
-  const bool energy = m.output.energy;
-  const Real before = energy ? StressPower(s.particles, w.velocity_gradient) : 0;
-  UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles);
-  if (energy) s.internal_work += 0.5 * c.dt * (before + StressPower(s.particles, w.velocity_gradient));
+  // rate of deformation d = sym(L) that the stress update uses (Mast 2013 (2.18)); UpdateStress
+  // sums P_n + P_{n+1} in its own loop.
+  Real power = 0;
+  UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles, m.output.energy ? &power : nullptr);
+  if (m.output.energy) s.internal_work += 0.5 * c.dt * power;
 }
 
 void BulkViscosityRateStage(const Model& m, const StepContext& c, State& s, Workspace& w,

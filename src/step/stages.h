@@ -28,6 +28,11 @@ void SensorsStage(const Model&, const StepContext&, State&, Workspace&, StepRepo
 // Particles that ended inside an obstacle go back to its surface (src/contact).
 void ObstacleProjectionStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridToParticleUslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// USL where nothing reads L_p but the stress update (no anti-locking, no bulk viscosity): G2P hands
+// each run's L_p to UpdateStressOfRun as soon as the run is gathered, instead of storing L_p for
+// UpdateStressStage (no L array: 72 bytes per particle less; docs/benchmarks.md). Same results
+// bitwise; its clock (grid_to_particle) includes the stress update.
+void GridToParticleStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void GridToParticleMuslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void RemapMomentumStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void VelocityGradientStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);

@@ -48,7 +48,13 @@ Pipeline MakePipeline(const Model& model) {
   if (model.damping.alpha > 0) p.push_back({Stage::kLocalDamping, LocalDampingStage});  // A3D (6.23)
   if (model.field_count > 0) p.push_back({Stage::kBodyContact, BodyContactStage});  // Anura3D §6.2
   const bool antilocking = AnyAntiLocking(model);
-  if (model.scheme == UpdateScheme::kUsl) {
+  // USL with nothing between G2P and the stress update that reads L_p or the stress: the update
+  // runs inside G2P, run by run (the stages skipped in between, obstacle projection, rigid bodies
+  // and sensors, read neither F, the stress nor L_p).
+  const bool fused = model.scheme == UpdateScheme::kUsl && !antilocking && !bulk_viscosity;
+  if (fused) {
+    p.push_back({Stage::kGridToParticle, GridToParticleStressStage});          // (2.17)-(2.22)
+  } else if (model.scheme == UpdateScheme::kUsl) {
     p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)
                  antilocking ? GridToParticleUslKeepStage : GridToParticleUslStage});
   } else {
@@ -63,7 +69,7 @@ Pipeline MakePipeline(const Model& model) {
   if (dynamic) p.push_back({Stage::kRigidBodies, RigidBodiesStage});             // Bullet
   if (!model.sensors.empty()) p.push_back({Stage::kSensors, SensorsStage});  // all reactions in
   if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
-  p.push_back({Stage::kUpdateStress, UpdateStressStage});                      // (2.18)-(2.20)
+  if (!fused) p.push_back({Stage::kUpdateStress, UpdateStressStage});          // (2.18)-(2.20)
   if (AnyStressAveraging(model))  // Table 4.1 steps 6-7, timed with the strain projection
     p.push_back({Stage::kAntiLocking, StressAveragingStage});
   if (bulk_viscosity) p.push_back({Stage::kBulkViscosity, BulkViscosityRateStage});  // q_p

@@ -17,6 +17,7 @@ struct Workspace {
   SparseGrid grid;
   std::vector<Mat3> velocity_gradient;  // L_p [1/s]        written by GridToParticle / VelocityGradient
   std::vector<Vec3> x_new;              // x_{n+1} [m] (MUSL) written by GridToParticle
+  std::vector<Real> run_power;          // stress power per G2P run [W] (GridToParticleStressStage)
   std::vector<uint8_t> exit_flag;       // scratch of DomainExit and ReorderParticles
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
   AntiLockingScratch antilocking;       // node sums of AntiLocking

@@ -62,7 +62,8 @@ enum class G2PMode { kFlip, kPicFlip, kApic };
 
 template <int kDim, class K, G2PMode kMode>
 void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& grid,
-                  Particles& P, std::vector<Mat3>* velocity_gradient, std::vector<Vec3>* x_new) {
+                  Particles& P, std::vector<Mat3>* velocity_gradient, std::vector<Vec3>* x_new,
+                  const GradientSink* sink) {
   using Pad = BlockPad<kDim, K>;
   const Real alpha = kMode == G2PMode::kFlip ? 1.0 : model.flip_ratio;
   ParallelFor(grid.runs.size(), 1, [&](size_t r) {
@@ -72,6 +73,8 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
     using Node =
         std::conditional_t<kMode == G2PMode::kApic && !kApicUsesGradient<K>, NodeV1, NodeV01>;
     thread_local std::vector<Node> halo;
+    thread_local std::vector<Mat3> run_gradient;  // L_p of the run, for the sink
+    if (sink) run_gradient.resize(run.end - run.begin);
     GatherHalos<kDim, K>(grid, blk, halo);
     const Vec3i origin = grid.block_origin[blk];
     for (uint32_t s = run.begin; s < run.end; ++s) {
@@ -90,7 +93,8 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
       for (int d = 0; d < 3; ++d)
         for (int k = 0; k < (d < kDim ? st.W : 1); ++k) off[d][k] = (st.base[d] + k) * ctx.dx - x[d];
       constexpr bool kNeedB = kMode == G2PMode::kApic && !kApicUsesGradient<K>;
-      const bool need_l = velocity_gradient || (kMode == G2PMode::kApic && kApicUsesGradient<K>);
+      const bool need_l =
+          velocity_gradient || sink || (kMode == G2PMode::kApic && kApicUsesGradient<K>);
       // The kernel is a tensor product, so the sums separate: for each (i, j) the k sums
       //   s0 = sum_k w_k v1,  s1 = sum_k g_k v1,  s2 = sum_k w_k oz_k v1,  sd = sum_k w_k (v1 - v0)
       // are formed once and then weighted by the (i, j) factors, instead of forming every term of
@@ -229,13 +233,17 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
         // FLIP increment (2.22) blended with PIC: v = a (v + sum N dv) + (1 - a) sum N v_{n+1}.
         P.v[p] = alpha * (P.v[p] + Vec3(dv[0], dv[1], dv[2])) + (1.0 - alpha) * v_pic;
       }
-      if (velocity_gradient) (*velocity_gradient)[p] = L;
+      if (velocity_gradient)
+        (*velocity_gradient)[p] = L;
+      else if (sink)
+        run_gradient[s - run.begin] = L;
       const Vec3 xn = x + ctx.dt * v_pic;  // x_{n+1} = x_n + sum N dx_i, dx_i = dt v_{n+1} (2.16)
       if (x_new)
         (*x_new)[p] = xn;
       else
         P.x[p] = xn;
     }
+    if (sink) (*sink)(r, &grid.sorted[run.begin], run_gradient.data(), run.end - run.begin);
   });
 }
 
@@ -271,20 +279,22 @@ void GradientBlocks(const StepContext& ctx, const SparseGrid& grid, const Partic
 
 void GridToParticle(const Model& model, const StepContext& ctx, const SparseGrid& grid,
                     Particles& particles, std::vector<Mat3>* velocity_gradient,
-                    std::vector<Vec3>* x_new) {
+                    std::vector<Vec3>* x_new, const GradientSink* sink) {
   if (velocity_gradient) velocity_gradient->resize(particles.size());
   if (x_new) x_new->resize(particles.size());
   DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
     switch (model.transfer) {
       case TransferScheme::kFlip:
-        GatherBlocks<kDim, K, G2PMode::kFlip>(model, ctx, grid, particles, velocity_gradient, x_new);
+        GatherBlocks<kDim, K, G2PMode::kFlip>(model, ctx, grid, particles, velocity_gradient,
+                                              x_new, sink);
         break;
       case TransferScheme::kPicFlip:
         GatherBlocks<kDim, K, G2PMode::kPicFlip>(model, ctx, grid, particles, velocity_gradient,
-                                                 x_new);
+                                                 x_new, sink);
         break;
       case TransferScheme::kApic:
-        GatherBlocks<kDim, K, G2PMode::kApic>(model, ctx, grid, particles, velocity_gradient, x_new);
+        GatherBlocks<kDim, K, G2PMode::kApic>(model, ctx, grid, particles, velocity_gradient,
+                                              x_new, sink);
         break;
     }
   });

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "contact/contact_report.h"
@@ -135,16 +136,21 @@ void ComputeBodyContactGaps(const Model& model, const StepContext& ctx, const Sp
 // Index into Model::body_contacts of the pair of fields (f, g), [f * field_count + g], or -1.
 std::vector<int> BodyContactPairTable(const Model& model);
 
+// Receives the velocity gradients L_p (2.17) of one run of G2P (grid.runs[run]) as soon as the run
+// is gathered: L[k] of particle ids[k], k < n, ids in the run's sorted order. Runs are handed over
+// concurrently, each once. The step fuses the stress update into G2P this way where nothing else
+// reads L (MakePipeline), so no per-particle L array is stored.
+using GradientSink =
+    std::function<void(size_t run, const uint32_t* ids, const Mat3* L, size_t n)>;
+
 // G2P (2.22) with the selected transfer (FLIP increment, PIC/FLIP blend, APIC) and the position
 // update x += dt sum N v_{n+1}. When velocity_gradient is non-null it also writes
-// MUSL helper: v_{n+1} = p/m from the re-mapped momentum, walls re-applied (no reaction logged).
-void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid);
-
-// L_p = sum v_{i,n+1} (x) grad N_ip (2.17) (USL). When x_new is non-null, new positions go
-// there instead of particles.x (MUSL, which still needs x_n for the re-mapped gradient).
+// L_p = sum v_{i,n+1} (x) grad N_ip (2.17) (USL); when sink is non-null it hands L_p to it run by
+// run instead. When x_new is non-null, new positions go there instead of particles.x (MUSL,
+// which still needs x_n for the re-mapped gradient).
 void GridToParticle(const Model& model, const StepContext& ctx, const SparseGrid& grid,
                     Particles& particles, std::vector<Mat3>* velocity_gradient,
-                    std::vector<Vec3>* x_new);
+                    std::vector<Vec3>* x_new, const GradientSink* sink = nullptr);
 
 // MUSL (Sulsky et al. 1995): re-map the updated particle momentum to the grid with the shape
 // functions of x_n, recompute v_{n+1} = p/m and re-apply the walls (no reaction logged).
