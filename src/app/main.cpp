@@ -62,7 +62,8 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
   // Memory at the first step (scene/memory_estimate.h; the run refuses a scene whose estimate
   // exceeds the available memory before seeding it).
   const MemoryEstimate memory =
-      EstimateMemory(double(P.size()), double(grid.block_count()), m.field_count, m.dim, P.layout);
+      EstimateMemory(double(P.size()), double(grid.block_count()), m.field_count, m.dim, P.layout,
+                     StepScratchFor(m));
   std::printf("scene      %s (%s)\n", m.name.c_str(), path.c_str());
   std::printf("dimension  %d-D%s, cell size %g m, %s, %s\n", m.dim,
               m.dim == 2 ? " plane strain" : "", m.dx, ShapeName(m.shape),
@@ -98,7 +99,7 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
   std::printf("memory     about %s (particles %s: %.0f bytes each; grid %s: %.0f bytes a block), "
               "%s available\n",
               FormatBytes(memory.total()).c_str(), FormatBytes(memory.particle_bytes).c_str(),
-              BytesPerParticle(P.layout), FormatBytes(memory.grid_bytes).c_str(),
+              BytesPerParticle(P.layout, StepScratchFor(m)), FormatBytes(memory.grid_bytes).c_str(),
               BytesPerBlock(m.field_count, m.dim), FormatBytes(AvailableMemory()).c_str());
   for (const std::string& w : SceneWarnings(scene)) std::printf("warning    %s\n", w.c_str());
   std::printf("scene OK\n");

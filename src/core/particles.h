@@ -82,6 +82,20 @@ struct alignas(8) ParticleLayout {
   int history_slots = kHistorySlots;
 };
 
+// The per-particle scratch arrays a run's step pipeline fills (Workspace, AntiLockingScratch);
+// StepScratchFor (step/step.h) derives it from the Model, as MakePipeline does;
+// BytesPerParticle (scene/memory_estimate.h) counts it. The default, every
+// array, is an upper bound.
+struct StepScratch {
+  bool velocity_gradient = true;  // L_p: every pipeline but USL with the update fused into G2P
+  bool x_n = true;                // x_new: MUSL, and USL with anti-locking
+  bool theta = true;              // volumetric anti-locking (AS1) and strain smoothing: theta_p
+  bool tensor = true;             // full-tensor anti-locking or its stress averaging: tensor, ok
+  bool inv_stretch = true;        // full-tensor anti-locking of the strain: (b^tr)^(-1/2)
+  bool theta_bar = true;          // hybrid control volumes: the node-projected trace
+  bool shift = true;              // particle shifting: the shift of each particle
+};
+
 // Design: material history lives in Particles (rather than in per-model SoA arrays) so that
 // reordering, compaction and checkpoints need no per-model code: when a run has a plastic model,
 // every particle carries one b^e (48 bytes) and the run's history slots (8 bytes each: 3 for the

@@ -22,6 +22,7 @@ enum class Stage : int {
   kAntiLocking,        // only when a material is anti-locked (src/stabilize)
   kUpdateStress,
   kBulkViscosity,      // only when a material has a bulk viscosity (src/stabilize): q around P2G
+  kParticleShifting,   // only when a material shifts its particles (src/stabilize)
   kDomainExit,
   kCheckState,
   kEnergy,

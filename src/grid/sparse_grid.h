@@ -42,10 +42,11 @@ struct SparseGrid {
   std::vector<uint32_t> sorted;         //   sorted[block_begin[b] .. block_begin[b+1])
   // The work items of the per-particle gathers (G2P, the velocity gradient, the anti-locking
   // gathers): runs sorted[begin .. end) of one block's particles. Blocks without particles are
-  // left out (they gathered a halo for nothing), and on more than one thread a block with more
-  // particles than a thread's share / 4 is cut into several runs, so that a small scene with a few
-  // crowded blocks keeps every thread busy. Each gather writes only its own particles, so the cut
-  // does not change any result. Set by BinParticles.
+  // left out (they gathered a halo for nothing), and a block with more than 1/16 of the particles
+  // (and more than 256) is cut into several runs, so that a small scene with a few crowded blocks
+  // keeps up to 4 threads busy. The cut does not depend on the thread count: each gather writes
+  // only its own particles, and the fused stress update's power, summed per run, is then the same
+  // for any thread count. Set by BinParticles.
   struct ParticleRun {
     uint32_t block, begin, end;
   };

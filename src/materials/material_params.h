@@ -187,6 +187,9 @@ struct Material {
   std::string name;
   Real density = 0;  // reference density rho_0 [kg/m^3]
   MaterialParams params;
+  // Particle shifting by the delta-correction (src/stabilize/particle_shifting.h; scene key
+  // `particle_shifting`): this material's particles move apart where they crowd.
+  bool particle_shifting = false;
 };
 
 // Lame's first parameter from K and G: lambda = K - 2G/3.

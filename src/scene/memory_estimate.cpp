@@ -38,7 +38,7 @@ double ReadNumber(const char* path) {
 
 }  // namespace
 
-double BytesPerParticle(const ParticleLayout& layout) {
+double BytesPerParticle(const ParticleLayout& layout, const StepScratch& scratch) {
   using P = Particles;
   // State: every Particles array the layout holds.
   double b = Elem<decltype(P::x)>() + Elem<decltype(P::v)>() + Elem<decltype(P::F)>() +
@@ -52,8 +52,15 @@ double BytesPerParticle(const ParticleLayout& layout) {
   if (layout.ext_force) b += Elem<decltype(P::ext_force)>();
   // Workspace per-particle scratch.
   using W = Workspace;
-  b += Elem<decltype(W::velocity_gradient)>() + Elem<decltype(W::x_new)>() +
-       Elem<decltype(W::exit_flag)>() + Elem<decltype(W::reorder)>();
+  b += Elem<decltype(W::exit_flag)>() + Elem<decltype(W::reorder)>();
+  if (scratch.velocity_gradient) b += Elem<decltype(W::velocity_gradient)>();
+  if (scratch.x_n) b += Elem<decltype(W::x_new)>();
+  using A = AntiLockingScratch;
+  if (scratch.theta) b += Elem<decltype(A::theta)>();
+  if (scratch.tensor) b += Elem<decltype(A::tensor)>() + Elem<decltype(A::tensor_ok)>();
+  if (scratch.inv_stretch) b += Elem<decltype(A::inv_stretch)>();
+  if (scratch.theta_bar) b += Elem<decltype(A::theta_bar)>();
+  if (scratch.shift) b += Elem<decltype(ShiftingScratch::shift)>();
   // Grid binning.
   using G = SparseGrid;
   b += Elem<decltype(G::particle_block)>() + Elem<decltype(G::sorted)>();
@@ -78,11 +85,11 @@ double BytesPerBlock(int fields, int dim) {
 }
 
 MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields, int dim,
-                              const ParticleLayout& layout) {
+                              const ParticleLayout& layout, const StepScratch& scratch) {
   MemoryEstimate m;
   m.particles = particles;
   m.grid_blocks = grid_blocks;
-  m.particle_bytes = particles * BytesPerParticle(layout);
+  m.particle_bytes = particles * BytesPerParticle(layout, scratch);
   m.grid_bytes = grid_blocks * BytesPerBlock(fields, dim);
   return m;
 }

@@ -19,15 +19,16 @@ struct MemoryEstimate {
 };
 
 // Bytes held per particle during a run (Particles, Workspace and SparseGrid per-particle arrays,
-// the snapshot scratch of the results writer), for the optional arrays of `layout`.
-double BytesPerParticle(const ParticleLayout& layout);
+// the snapshot scratch of the results writer), for the optional arrays of `layout` and the step
+// scratch of `scratch`.
+double BytesPerParticle(const ParticleLayout& layout, const StepScratch& scratch = {});
 // Bytes of node fields per active block with `fields` per-body velocity fields (0 without
 // body_contact): 8^3 nodes in 3-D, 8^2 in 2-D.
 double BytesPerBlock(int fields, int dim);
 
 // Pre: particles, grid_blocks >= 0.
 MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields, int dim,
-                              const ParticleLayout& layout);
+                              const ParticleLayout& layout, const StepScratch& scratch = {});
 
 // Blocks of 8^3 nodes covering the box [lo, hi] [m] at cell size dx [m], one block more on each
 // side for the stencils that cross a block face; z is one block in 2-D. Pre: dx > 0.

@@ -20,6 +20,7 @@
 #include "materials/update_stress.h"
 #include "mesh/mesh.h"
 #include "scene/memory_estimate.h"
+#include "step/step.h"
 #include "scene/particle_sampling.h"
 #include "scene/scene_error.h"
 
@@ -53,18 +54,19 @@ std::string Point(const Vec3& x, int dim) {
 // domain) needs more memory than the machine has available (memory_estimate.h). `qualifier`
 // ("at most ") says that the count is an upper bound.
 void CheckMemory(const SceneSpec& spec, double particles, Aabb box, int fields,
-                 const ParticleLayout& layout, const std::string& qualifier) {
+                 const ParticleLayout& layout, const StepScratch& scratch,
+                 const std::string& qualifier) {
   box.min = box.min.cwiseMax(spec.domain.min);
   box.max = box.max.cwiseMin(spec.domain.max);
   const MemoryEstimate m = EstimateMemory(
       particles, BlocksCovering(box.min, box.max, spec.grid.cell_size, spec.dimension), fields,
-      spec.dimension, layout);
+      spec.dimension, layout, scratch);
   const double available = AvailableMemory();
   if (m.total() <= available) return;
   const SourceLoc& loc = spec.bodies.empty() ? SourceLoc{} : spec.bodies.front().loc;
   Fail(loc, "bodies",
        "the run needs about " + FormatBytes(m.total()) + " of memory (" + qualifier +
-           Num(std::round(particles)) + " particles x " + Num(BytesPerParticle(layout)) + " bytes + " +
+           Num(std::round(particles)) + " particles x " + Num(BytesPerParticle(layout, scratch)) + " bytes + " +
            Num(m.grid_blocks) + " grid blocks x " + Num(BytesPerBlock(fields, spec.dimension)) +
            " bytes), more than the " + FormatBytes(available) +
            " available on this machine; use a larger grid.cell_size or fewer particles_per_cell");
@@ -335,9 +337,14 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   model.wall_gap_test = spec.domain.gap_test;
   for (const MaterialSpec& m : spec.materials) {
     model.materials.push_back(
-        Material{m.name, m.density, FindMaterialKind(m.model).make_params(m)});
+        Material{m.name, m.density, FindMaterialKind(m.model).make_params(m), m.particle_shifting});
     model.antilocking.push_back(ResolvedAntiLocking(m));
     model.bulk_viscosity.push_back(m.bulk_viscosity);
+    if (m.particle_shifting && model.shape != ShapeFunction::kQuadraticBspline) {
+      Fail(m.loc, "materials." + m.name + ".particle_shifting",
+           "particle shifting needs grid.shape_function: quadratic_bspline (its node volumes "
+           "are the B-spline's integrals)");
+    }
   }
   model.damping.alpha = spec.damping.local;
   if (spec.damping.until) model.damping.until = *spec.damping.until;
@@ -394,6 +401,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
   const bool tractions = std::any_of(spec.bodies.begin(), spec.bodies.end(),
                                      [](const BodySpec& b) { return !b.tractions.empty(); });
   const ParticleLayout layout = ParticleLayoutFor(model, tractions);
+  const StepScratch scratch = StepScratchFor(model);
   // lattice points of each region's bounding box bound its particles from above (exactly for
   // boxes); mesh regions are counted after seeding, below.
   {
@@ -410,7 +418,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
       box.max = box.max.cwiseMax(r.max);
     }
     if (particles > 0) {
-      CheckMemory(spec, particles, box, model.field_count, layout, "at most ");
+      CheckMemory(spec, particles, box, model.field_count, layout, scratch, "at most ");
     }
   }
 
@@ -437,7 +445,7 @@ void BuildScene(const SceneSpec& spec, Model& model, State& state) {
         box.max = box.max.cwiseMax(x);
       }
     }
-    CheckMemory(spec, total, box, model.field_count, layout, "");
+    CheckMemory(spec, total, box, model.field_count, layout, scratch, "");
   }
 
   // Lay the particles out grouped by material, then by anti-locking setting (the material's

@@ -537,6 +537,7 @@ std::vector<std::string> MaterialKeys(const MaterialKind& kind) {
   for (const ParamDesc& d : kind.params) keys.push_back(d.key);
   keys.push_back("antilocking");
   keys.push_back("bulk_viscosity");
+  keys.push_back("particle_shifting");
   return keys;
 }
 
@@ -645,6 +646,9 @@ MaterialSpec Parser::ParseMaterial(const YAML::Node& n, const std::string& path)
   }
   if (const YAML::Node al = n["antilocking"]) {
     m.antilocking = ParseAntiLocking(al, Child(path, "antilocking"));
+  }
+  if (const YAML::Node ps = n["particle_shifting"]) {
+    m.particle_shifting = Bool(ps, Child(path, "particle_shifting"));
   }
   if (const YAML::Node bv = n["bulk_viscosity"]) {
     // bulk_viscosity: {quadratic: c0, linear: c1} (docs/antilocking.md, "Artificial bulk
@@ -1792,6 +1796,7 @@ std::string SceneSpecToYaml(const SceneSpec& spec) {
       }
     }
     EmitAntiLocking(e, ResolvedAntiLocking(m));
+    if (m.particle_shifting) e << YAML::Key << "particle_shifting" << YAML::Value << true;
     if (m.bulk_viscosity.enabled) {  // only when on (resolved scenes without it stay the same)
       e << YAML::Key << "bulk_viscosity" << YAML::Value << YAML::Flow << YAML::BeginMap
         << YAML::Key << "quadratic" << YAML::Value << Num(m.bulk_viscosity.quadratic)

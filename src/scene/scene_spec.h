@@ -102,6 +102,8 @@ struct MaterialSpec {
   AntiLockingSpec antilocking;
   // `bulk_viscosity: {quadratic, linear}` (docs/antilocking.md); disabled when not written.
   BulkViscosity bulk_viscosity;
+  // `particle_shifting: true` (docs/antilocking.md, "Particle shifting"); off when not written.
+  bool particle_shifting = false;
   SourceLoc loc;
 
   // Value of a model key: as written, else the kind's default. Pre: `key` is one of the kind's.

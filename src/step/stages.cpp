@@ -198,6 +198,19 @@ void BulkViscosityRestoreStage(const Model&, const StepContext&, State& s, Works
   RestoreStress(s.particles, w.bulk_viscosity);
 }
 
+// Before G2P: the particles are at x_n, where the grid was binned (particle_shifting.h).
+void ParticleShiftComputeStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                               StepReport&) {
+  ComputeParticleShift(m, c, s.groups, s.particles, s.rigid, w.grid, w.shifting);
+}
+
+// After G2P (and MUSL's velocity gradient): particles.x holds x_{n+1}; obstacle projection,
+// which follows, puts a particle shifted into an obstacle back on its surface.
+void ParticleShiftApplyStage(const Model& m, const StepContext&, State& s, Workspace& w,
+                             StepReport&) {
+  ApplyParticleShift(m, s.particles, w.shifting);
+}
+
 namespace {
 // Walled faces of the domain, in face order.
 std::vector<int> WalledFaces(const Model& m) {

@@ -48,6 +48,8 @@ void UpdateStressStage(const Model&, const StepContext&, State&, Workspace&, Ste
 void BulkViscosityRateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void BulkViscosityApplyStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void BulkViscosityRestoreStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void ParticleShiftComputeStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void ParticleShiftApplyStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void DomainExitStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void CheckStateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void EnergyStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);

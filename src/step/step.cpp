@@ -28,6 +28,29 @@
 
 namespace surge {
 
+StepScratch StepScratchFor(const Model& model) {
+  StepScratch s{};
+  const bool antilocking = AnyAntiLocking(model);
+  const bool usl = model.scheme == UpdateScheme::kUsl;
+  // USL with nothing between G2P and the stress update that reads L_p: the update runs inside
+  // G2P, run by run, and L_p is never stored (GridToParticleStressStage).
+  s.velocity_gradient = !(usl && !antilocking && !AnyBulkViscosity(model));
+  s.x_n = !usl || antilocking;  // MUSL's x_{n+1}; USL keeps x_n for the anti-locking's grid
+  s.theta = s.tensor = s.inv_stretch = s.theta_bar = false;
+  s.shift = AnyParticleShifting(model);
+  for (const AntiLocking& a : model.antilocking) {
+    if (a.method == AntiLockingMethod::kNone) continue;
+    const bool full = a.method == AntiLockingMethod::kHybrid ||
+                      (a.method != AntiLockingMethod::kSmoothing &&
+                       a.approach != AntiLockingApproach::kVolumetric);
+    s.theta |= !full;  // ProjectVolumetricStrain, SmoothVolumetricStrain
+    s.tensor |= full;  // ProjectFullTensor(Stress)
+    s.inv_stretch |= full;
+    s.theta_bar |= a.method == AntiLockingMethod::kHybrid;
+  }
+  return s;
+}
+
 Pipeline MakePipeline(const Model& model) {
   Pipeline p;
   p.push_back({Stage::kRebuildGrid, RebuildGridStage});
@@ -51,7 +74,10 @@ Pipeline MakePipeline(const Model& model) {
   // USL with nothing between G2P and the stress update that reads L_p or the stress: the update
   // runs inside G2P, run by run (the stages skipped in between, obstacle projection, rigid bodies
   // and sensors, read neither F, the stress nor L_p).
-  const bool fused = model.scheme == UpdateScheme::kUsl && !antilocking && !bulk_viscosity;
+  const bool fused = !StepScratchFor(model).velocity_gradient;
+  // The delta-correction's shift from x_n and the grid binned there; made after G2P.
+  const bool shifting = AnyParticleShifting(model);
+  if (shifting) p.push_back({Stage::kParticleShifting, ParticleShiftComputeStage});
   if (fused) {
     p.push_back({Stage::kGridToParticle, GridToParticleStressStage});          // (2.17)-(2.22)
   } else if (model.scheme == UpdateScheme::kUsl) {
@@ -62,6 +88,7 @@ Pipeline MakePipeline(const Model& model) {
     p.push_back({Stage::kRemapMomentum, RemapMomentumStage});                  // Sulsky 1995
     p.push_back({Stage::kVelocityGradient, VelocityGradientStage});            // (2.17)
   }
+  if (shifting) p.push_back({Stage::kParticleShifting, ParticleShiftApplyStage});  // x_{n+1}
   if (obstacles) p.push_back({Stage::kObstacleProjection, ObstacleProjectionStage});
   const bool dynamic = std::any_of(model.obstacles.begin(), model.obstacles.end(), [](const Obstacle& o) {
     return o.motion.kind == ObstacleMotionKind::kDynamic;

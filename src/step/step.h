@@ -41,6 +41,10 @@ using Pipeline = std::vector<PipelineStage>;
 // The stages this model needs, in cycle order; unneeded stages are not in the list.
 Pipeline MakePipeline(const Model& model);
 
+// The per-particle scratch arrays MakePipeline's stages fill for this model (the memory
+// estimate's share of Workspace and AntiLockingScratch).
+StepScratch StepScratchFor(const Model& model);
+
 // Time step for the next step: CFL rule dt = C dx / max_p (c_p + |v_p|) (spec §1.7) and the
 // viscous limit (ViscousTimeStep), bounded by max_dt, the fixed override and the remaining time
 // to Model::time.end. Within 10 CFL steps of the end the rest is split into equal steps (no

@@ -9,6 +9,7 @@
 #include "rigid/rigid_world.h"
 #include "stabilize/antilocking.h"
 #include "stabilize/bulk_viscosity.h"
+#include "stabilize/particle_shifting.h"
 #include "transfer/transfer.h"
 
 namespace surge {
@@ -21,6 +22,7 @@ struct Workspace {
   std::vector<uint8_t> exit_flag;       // scratch of DomainExit and ReorderParticles
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
   AntiLockingScratch antilocking;       // node sums of AntiLocking
+  ShiftingScratch shifting;             // particle shifting's node excess and particle shifts
   BulkViscosityScratch bulk_viscosity;  // q_p between steps: its q, id and dt_bound are saved
                                         // in checkpoints (io/checkpoint.h)
   ContactScratch contact;               // broad phase and partial sums of the obstacle contact

@@ -105,11 +105,11 @@ void BinParticles(SparseGrid& grid) {
   cursor.assign(grid.block_begin.begin(), grid.block_begin.end() - 1);
   for (size_t p = 0; p < n; ++p) grid.sorted[cursor[grid.particle_block[p]]++] = uint32_t(p);
 
-  // Gather work items: one run per non-empty block, cut on several threads into runs of at most
-  // about a quarter of a thread's share (never below 256 particles: each run gathers its block's
-  // node halo once).
-  const size_t threads = WorkerThreads();
-  const size_t cap = threads <= 1 ? n + 1 : std::max<size_t>(256, n / (4 * threads) + 1);
+  // Gather work items: one run per non-empty block, cut into runs of at most n / 16 particles
+  // (never below 256: each run gathers its block's node halo once), so that up to 4 threads
+  // each get about 4 runs. The cut depends on the particles only, not on the thread count:
+  // the fused stress update sums its stress power per run (GridToParticleStressStage).
+  const size_t cap = std::max<size_t>(256, n / 16 + 1);
   grid.runs.clear();
   for (size_t b = 0; b < nb; ++b) {
     const uint32_t begin = grid.block_begin[b], count = grid.block_begin[b + 1] - begin;

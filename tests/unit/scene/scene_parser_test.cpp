@@ -223,7 +223,7 @@ TEST(SceneParserTest, FluidKeys) {
   ExpectError(WithMaterial(water + "viscosity: 0.001, shear_modulus: 1e6}"), 7,
               "materials.steel.shear_modulus",
               "unknown key 'shear_modulus' (expected one of: model, density, bulk_modulus, "
-              "viscosity, equation_of_state, tait_gamma, antilocking, bulk_viscosity)");
+              "viscosity, equation_of_state, tait_gamma, antilocking, bulk_viscosity, particle_shifting)");
   ExpectError(WithMaterial(water + "viscosity: -0.001}"), 7, "materials.steel.viscosity",
               "must be >= 0 [Pa s], got -0.001");
   ExpectError(WithMaterial(water + "equation_of_state: tait}"), 7, "materials.steel.viscosity",
@@ -1008,6 +1008,24 @@ TEST(SceneParserTest, MassScalingKeys) {
   const LoadedScene again = LoadSceneFromString(on.resolved_yaml, "again.yaml");
   EXPECT_EQ(again.model.mass_scaling.factor, 25);
   EXPECT_EQ(again.model.mass_scaling.until, 0.5);
+}
+
+TEST(SceneParserTest, ParticleShiftingKey) {
+  const std::string water =
+      "{model: newtonian_fluid, density: 1000, bulk_modulus: 2e6, viscosity: 0.001, ";
+  ExpectError(WithMaterial(water + "particle_shifting: 3}"), 7,
+              "materials.steel.particle_shifting", "true or false");
+  // Its node volumes are the quadratic B-spline's integrals.
+  ExpectError(Replace(WithMaterial(water + "particle_shifting: true}"), "grid: {cell_size: 0.25}",
+                      "grid: {cell_size: 0.25, shape_function: linear}"),
+              7, "materials.steel.particle_shifting", "quadratic_bspline");
+  const LoadedScene off = LoadSceneFromString(WithMaterial(water + "particle_shifting: false}"), "ok.yaml");
+  EXPECT_FALSE(off.model.materials[0].particle_shifting);
+  EXPECT_EQ(off.resolved_yaml.find("particle_shifting"), std::string::npos);
+  const LoadedScene on = LoadSceneFromString(WithMaterial(water + "particle_shifting: true}"), "ok.yaml");
+  EXPECT_TRUE(on.model.materials[0].particle_shifting);
+  const LoadedScene again = LoadSceneFromString(on.resolved_yaml, "again.yaml");
+  EXPECT_TRUE(again.model.materials[0].particle_shifting);
 }
 
 TEST(SceneParserTest, BulkViscosityKeys) {

@@ -1,0 +1,82 @@
+// StepScratchFor (step.h), the memory estimate's per-particle step scratch, against what the
+// pipeline's stages actually fill: after a few steps every scratch array StepScratchFor names
+// holds one entry per particle and every other one is empty (the estimate neither misses an
+// array nor counts one the run does not hold).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "scene/memory_estimate.h"
+#include "scene/scene.h"
+#include "step/step.h"
+
+namespace surge {
+namespace {
+
+// A 2-D elastic block falling in a box, with a material's extra keys and the grid's update scheme.
+LoadedScene Block(const std::string& material_keys, const std::string& update) {
+  const std::string yaml =
+      "name: scratch_test\ndimension: 2\ntime: {end: 1.0, cfl: 0.4}\n"
+      "gravity: [0, -10]\n"
+      "grid: {cell_size: 0.1, update: " + update + "}\n"
+      "domain: {min: [0, 0], max: [1, 1], walls: {x-: slip, x+: slip, y-: slip, y+: slip}}\n"
+      "materials:\n  m: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e5, "
+      "poisson_ratio: 0.3" + material_keys + "}\n"
+      "bodies:\n  - name: b\n    material: m\n    region: {box: {min: [0.3, 0.2], max: [0.7, 0.5]}}\n";
+  return LoadSceneFromString(yaml, "scratch_test.yaml");
+}
+
+void ExpectScratchAsEstimated(const std::string& material_keys, const std::string& update) {
+  SCOPED_TRACE(update + " with" + material_keys);
+  LoadedScene scene = Block(material_keys, update);
+  const StepScratch expected = StepScratchFor(scene.model);
+  const Pipeline pipeline = MakePipeline(scene.model);
+  Workspace work;
+  StepReport report;
+  for (int i = 0; i < 3; ++i) {
+    Step(scene.model, pipeline, scene.state, work, report);
+    ASSERT_EQ(report.health.status, HealthStatus::kOk);
+  }
+  const size_t n = scene.state.particles.size();
+  ASSERT_GT(n, 0u);
+  const auto held = [&](size_t size) { return size == n; };
+  const auto empty_or_held = [&](size_t size) { return size == 0 || size == n; };
+  for (size_t size : {work.velocity_gradient.size(), work.x_new.size(),
+                      work.antilocking.theta.size(), work.antilocking.tensor.size(),
+                      work.antilocking.inv_stretch.size(), work.antilocking.theta_bar.size(),
+                      work.shifting.shift.size()})
+    EXPECT_TRUE(empty_or_held(size)) << size;
+  EXPECT_EQ(held(work.velocity_gradient.size()), expected.velocity_gradient);
+  EXPECT_EQ(held(work.x_new.size()), expected.x_n);
+  EXPECT_EQ(held(work.antilocking.theta.size()), expected.theta);
+  EXPECT_EQ(held(work.antilocking.tensor.size()), expected.tensor);
+  EXPECT_EQ(held(work.antilocking.tensor_ok.size()), expected.tensor);
+  EXPECT_EQ(held(work.antilocking.inv_stretch.size()), expected.inv_stretch);
+  EXPECT_EQ(held(work.antilocking.theta_bar.size()), expected.theta_bar);
+  EXPECT_EQ(held(work.shifting.shift.size()), expected.shift);
+}
+
+TEST(StepScratchTest, EstimateNamesTheArraysEachPipelineFills) {
+  ExpectScratchAsEstimated("", "usl");  // the stress update fused into G2P: no L_p, no x_n
+  ExpectScratchAsEstimated("", "musl");
+  ExpectScratchAsEstimated(", bulk_viscosity: {}", "usl");
+  ExpectScratchAsEstimated(", antilocking: {method: node, strain: increment}", "usl");
+  ExpectScratchAsEstimated(", antilocking: {method: cell, approach: constant_volumetric}", "usl");
+  ExpectScratchAsEstimated(", antilocking: {method: hybrid, strain: increment}", "usl");
+  ExpectScratchAsEstimated(", antilocking: {method: smoothing}", "musl");
+  ExpectScratchAsEstimated(", particle_shifting: true", "usl");
+}
+
+TEST(StepScratchTest, FusedRunIsEstimatedWithoutTheVelocityGradient) {
+  LoadedScene fused = Block("", "usl");
+  LoadedScene musl = Block("", "musl");
+  const ParticleLayout& layout = fused.state.particles.layout;
+  // L_p (9 doubles) and x_n (3) are the difference; the default scratch is the upper bound.
+  EXPECT_DOUBLE_EQ(BytesPerParticle(layout, StepScratchFor(musl.model)) -
+                       BytesPerParticle(layout, StepScratchFor(fused.model)),
+                   12 * sizeof(Real));
+  EXPECT_LT(BytesPerParticle(layout, StepScratchFor(musl.model)), BytesPerParticle(layout));
+}
+
+}  // namespace
+}  // namespace surge
