@@ -100,7 +100,7 @@ int Check(const std::string& path, const std::vector<std::string>& overrides) {
               "%s available\n",
               FormatBytes(memory.total()).c_str(), FormatBytes(memory.particle_bytes).c_str(),
               BytesPerParticle(P.layout, StepScratchFor(m)), FormatBytes(memory.grid_bytes).c_str(),
-              BytesPerBlock(m.field_count, m.dim), FormatBytes(AvailableMemory()).c_str());
+              BytesPerBlock(m.field_count, m.dim, StepScratchFor(m)), FormatBytes(AvailableMemory()).c_str());
   for (const std::string& w : SceneWarnings(scene)) std::printf("warning    %s\n", w.c_str());
   std::printf("scene OK\n");
   return kExitOk;

@@ -82,7 +82,8 @@ struct alignas(8) ParticleLayout {
   int history_slots = kHistorySlots;
 };
 
-// The per-particle scratch arrays a run's step pipeline fills (Workspace, AntiLockingScratch);
+// The per-particle scratch arrays a run's step pipeline fills (Workspace, AntiLockingScratch),
+// and the optional node arrays of the grid (SparseGrid);
 // StepScratchFor (step/step.h) derives it from the Model, as MakePipeline does;
 // BytesPerParticle (scene/memory_estimate.h) counts it. The default, every
 // array, is an upper bound.
@@ -94,6 +95,9 @@ struct StepScratch {
   bool inv_stretch = true;        // full-tensor anti-locking of the strain: (b^tr)^(-1/2)
   bool theta_bar = true;          // hybrid control volumes: the node-projected trace
   bool shift = true;              // particle shifting: the shift of each particle
+  // Grid nodes (BytesPerBlock):
+  bool node_reaction = true;      // SparseGrid::reaction: force sensors only
+  bool node_momentum = true;      // a second buffer for p_i beside v_{i,n}: MUSL's re-map only
 };
 
 // Design: material history lives in Particles (rather than in per-model SoA arrays) so that

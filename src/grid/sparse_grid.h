@@ -71,13 +71,21 @@ struct SparseGrid {
   }
   // --- Node fields, size blocks * block_nodes. ---
   std::vector<Real> mass;           // lumped mass m_i [kg]                (2.12)
+  // p_i and v_{i,n} share one buffer (performance issue: bytes per particle): ParticleToGrid sums
+  // p_i into `momentum`; UpdateGridVelocity overwrites it in place with v_{i,n} and swaps it into
+  // `velocity`, leaving `momentum` with velocity's old buffer (empty in USL; MUSL's RemapMomentum
+  // sizes it again); BuildTopology swaps it back when `momentum` is empty. Read `momentum` only
+  // between P2G and the grid update (and after MUSL's re-map), `velocity` only after the update.
   std::vector<Vec3> momentum;       // p_i [kg m/s]                        (2.12)
   std::vector<Vec3> force;          // f_int + f_ext (without gravity) [N] (2.11)
   std::vector<Vec3> velocity;       // v_{i,n} = p_i / m_i [m/s]           (2.13)
   std::vector<Vec3> velocity_new;   // v_{i,n+1} after boundary conditions (2.14)
   std::vector<Vec3> reaction;       // force on the structures (walls, obstacles) at the node,
                                     // m (v_u - v_c) / dt, this step [N]   (spec §5.3);
-                                    // written only when the scene has force sensors
+                                    // held (sized) only when keep_reaction
+  // Whether `reaction` is held: only the force sensors read it (RebuildGrid sets it from the
+  // Model); without sensors it stays empty and costs no memory.
+  bool keep_reaction = true;
   // --- Per-body velocity fields (Model::field_count > 0 only; else empty), [f * nodes + i]. ---
   int field_count = 0;
   std::vector<Real> field_mass;          // m_i,f [kg]                      (2.12) per field

@@ -84,6 +84,8 @@ void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid) 
   // The P2G sums start at zero: cleared block by block in parallel (a serial clear of 56 bytes
   // per node was a tenth of a small run's grid rebuild).
   grid.mass.resize(nodes);
+  // momentum and velocity share a buffer (SparseGrid::momentum): take it back from velocity.
+  if (grid.momentum.empty()) grid.momentum.swap(grid.velocity);
   grid.momentum.resize(nodes);
   grid.force.resize(nodes);
   const size_t per_block = size_t(grid.block_nodes);
@@ -95,9 +97,9 @@ void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid) 
     std::fill(grid.force.begin() + ptrdiff_t(begin), grid.force.begin() + ptrdiff_t(end),
               Vec3::Zero());
   });
-  grid.velocity.resize(nodes);
   grid.velocity_new.resize(nodes);
-  grid.reaction.resize(nodes);
+  if (grid.keep_reaction) grid.reaction.resize(nodes);
+  else grid.reaction = {};
 }
 
 void LookupBlocks(const SparseGrid& grid, const Vec3i* blocks, size_t n, int32_t* out) {

@@ -70,11 +70,13 @@ double BytesPerParticle(const ParticleLayout& layout, const StepScratch& scratch
   return b;
 }
 
-double BytesPerBlock(int fields, int dim) {
+double BytesPerBlock(int fields, int dim, const StepScratch& scratch) {
   using G = SparseGrid;
-  const double node = Elem<decltype(G::mass)>() + Elem<decltype(G::momentum)>() +
-                      Elem<decltype(G::force)>() + Elem<decltype(G::velocity)>() +
-                      Elem<decltype(G::velocity_new)>() + Elem<decltype(G::reaction)>();
+  // momentum and velocity share one buffer (SparseGrid::momentum) but in MUSL.
+  double node = Elem<decltype(G::mass)>() + Elem<decltype(G::momentum)>() +
+                Elem<decltype(G::force)>() + Elem<decltype(G::velocity_new)>();
+  if (scratch.node_momentum) node += Elem<decltype(G::velocity)>();
+  if (scratch.node_reaction) node += Elem<decltype(G::reaction)>();
   const double field = Elem<decltype(G::field_mass)>() + Elem<decltype(G::field_momentum)>() +
                        Elem<decltype(G::field_force)>() + Elem<decltype(G::field_mass_moment)>() +
                        Elem<decltype(G::field_velocity)>() + Elem<decltype(G::field_velocity_new)>();
@@ -90,7 +92,7 @@ MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields, 
   m.particles = particles;
   m.grid_blocks = grid_blocks;
   m.particle_bytes = particles * BytesPerParticle(layout, scratch);
-  m.grid_bytes = grid_blocks * BytesPerBlock(fields, dim);
+  m.grid_bytes = grid_blocks * BytesPerBlock(fields, dim, scratch);
   return m;
 }
 

@@ -23,8 +23,8 @@ struct MemoryEstimate {
 // scratch of `scratch`.
 double BytesPerParticle(const ParticleLayout& layout, const StepScratch& scratch = {});
 // Bytes of node fields per active block with `fields` per-body velocity fields (0 without
-// body_contact): 8^3 nodes in 3-D, 8^2 in 2-D.
-double BytesPerBlock(int fields, int dim);
+// body_contact) and the optional node arrays of `scratch`: 8^3 nodes in 3-D, 8^2 in 2-D.
+double BytesPerBlock(int fields, int dim, const StepScratch& scratch = {});
 
 // Pre: particles, grid_blocks >= 0.
 MemoryEstimate EstimateMemory(double particles, double grid_blocks, int fields, int dim,

@@ -67,7 +67,7 @@ void CheckMemory(const SceneSpec& spec, double particles, Aabb box, int fields,
   Fail(loc, "bodies",
        "the run needs about " + FormatBytes(m.total()) + " of memory (" + qualifier +
            Num(std::round(particles)) + " particles x " + Num(BytesPerParticle(layout, scratch)) + " bytes + " +
-           Num(m.grid_blocks) + " grid blocks x " + Num(BytesPerBlock(fields, spec.dimension)) +
+           Num(m.grid_blocks) + " grid blocks x " + Num(BytesPerBlock(fields, spec.dimension, scratch)) +
            " bytes), more than the " + FormatBytes(available) +
            " available on this machine; use a larger grid.cell_size or fewer particles_per_cell");
 }

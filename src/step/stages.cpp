@@ -133,9 +133,20 @@ void GridToParticleStressStage(const Model& m, const StepContext& c, State& s, W
   }
 }
 
+namespace {
+// The positions the grid was binned with, x_n, for the stages after G2P that need them: the
+// particles' own while their advection is deferred (AdvectStage), else Workspace::x_new.
+const std::vector<Vec3>& StartPositions(const Model& m, const State& s, const Workspace& w) {
+  return DeferredAdvection(m) ? s.particles.x : w.x_new;
+}
+}  // namespace
+
 void GridToParticleMuslStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                              StepReport&) {
-  GridToParticle(m, c, w.grid, s.particles, nullptr, &w.x_new);
+  if (DeferredAdvection(m))
+    GridToParticle(m, c, w.grid, s.particles, nullptr, nullptr, nullptr, /*advect=*/false);
+  else
+    GridToParticle(m, c, w.grid, s.particles, nullptr, &w.x_new);
 }
 
 void RemapMomentumStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -150,7 +161,8 @@ void RemapMomentumStage(const Model& m, const StepContext& c, State& s, Workspac
 void VelocityGradientStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                            StepReport&) {
   ComputeVelocityGradient(m, c, w.grid, s.particles, w.velocity_gradient);
-  s.particles.x.swap(w.x_new);  // commit x_{n+1}: the re-mapped gradient needed x_n
+  // Commit x_{n+1}: the re-mapped gradient needed x_n (deferred: AdvectStage moves them later).
+  if (!DeferredAdvection(m)) s.particles.x.swap(w.x_new);
 }
 
 void GridToParticleUslKeepStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -159,17 +171,28 @@ void GridToParticleUslKeepStage(const Model& m, const StepContext& c, State& s, 
   s.particles.x.swap(w.x_new);  // commit x_{n+1}; x_new now holds x_n
 }
 
-void AntiLockingStage(const Model& m, const StepContext& c, State& s, Workspace& w,
-                      StepReport&) {
-  ProjectVolumetricStrain(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking,
-                          w.velocity_gradient);
+void GridToParticleUslDeferStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                                 StepReport&) {
+  GridToParticle(m, c, w.grid, s.particles, &w.velocity_gradient, nullptr, nullptr,
+                 /*advect=*/false);
 }
 
-// Runs right after UpdateStress; x_new holds x_n there (the USL keep stage and MUSL's velocity
-// gradient stage swapped it), the positions the grid was binned with.
+void AdvectStage(const Model&, const StepContext& c, State& s, Workspace&, StepReport&) {
+  AdvectParticles(c, s.particles);
+}
+
+void AntiLockingStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                      StepReport&) {
+  ProjectVolumetricStrain(m, c, s.groups, s.particles, StartPositions(m, s, w), w.grid,
+                          w.antilocking, w.velocity_gradient);
+}
+
+// Runs right after UpdateStress, with x_n, the positions the grid was binned with: the particles'
+// own while the advection is deferred, else x_new (the USL keep stage and MUSL's velocity gradient
+// stage swapped it there).
 void StressAveragingStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                           StepReport&) {
-  ProjectStress(m, c, s.groups, s.particles, w.x_new, w.grid, w.antilocking);
+  ProjectStress(m, c, s.groups, s.particles, StartPositions(m, s, w), w.grid, w.antilocking);
 }
 
 void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -204,8 +227,8 @@ void ParticleShiftComputeStage(const Model& m, const StepContext& c, State& s, W
   ComputeParticleShift(m, c, s.groups, s.particles, s.rigid, w.grid, w.shifting);
 }
 
-// After G2P (and MUSL's velocity gradient): particles.x holds x_{n+1}; obstacle projection,
-// which follows, puts a particle shifted into an obstacle back on its surface.
+// After G2P (and MUSL's velocity gradient, and AdvectStage): particles.x holds x_{n+1}; obstacle
+// projection, which follows, puts a particle shifted into an obstacle back on its surface.
 void ParticleShiftApplyStage(const Model& m, const StepContext&, State& s, Workspace& w,
                              StepReport&) {
   ApplyParticleShift(m, s.particles, w.shifting);

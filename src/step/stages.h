@@ -39,7 +39,12 @@ void VelocityGradientStage(const Model&, const StepContext&, State&, Workspace&,
 // USL with anti-locking: G2P writes L_p and x_{n+1} to scratch, then commits x_{n+1} by a swap,
 // so that (as after MUSL's VelocityGradient) Workspace::x_new holds x_n for AntiLocking.
 void GridToParticleUslKeepStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
-// Volumetric anti-locking of L_p (src/stabilize) with the shape functions at x_n = Workspace::x_new.
+// USL with anti-locking and APIC (DeferredAdvection): G2P writes v_p, C_p and L_p and leaves the
+// particles at x_n; AdvectStage moves them to x_{n+1} = x_n + dt v_p after the stress stages.
+void GridToParticleUslDeferStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+void AdvectStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// Volumetric anti-locking of L_p (src/stabilize) with the shape functions at x_n (the particles'
+// positions with deferred advection, else Workspace::x_new).
 void AntiLockingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void StressAveragingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void UpdateStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);

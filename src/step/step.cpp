@@ -4,8 +4,12 @@
 //   USL : RebuildGrid -> ReorderParticles -> ParticleToGrid -> GridUpdate -> GridToParticle (+ L_p) -> UpdateStress
 //   MUSL: RebuildGrid -> ReorderParticles -> ParticleToGrid -> GridUpdate -> GridToParticle -> RemapMomentum
 //         -> VelocityGradient -> UpdateStress
-//   then: DomainExit -> CheckState -> Energy
+//   then: [AntiLocking] -> UpdateStress -> [StressAveraging] -> [Advect] -> [ParticleShifting]
+//         -> [ObstacleProjection] -> [RigidBodies] -> [Sensors] -> [BulkViscosity]
+//         -> DomainExit -> CheckState -> Energy
 //   AntiLocking (Mast 2013 Table 4.1) runs just before UpdateStress when a material asks for it.
+//   With APIC where x_n is still needed after G2P (MUSL, anti-locking), G2P leaves the particles
+//   at x_n and Advect moves them after the stress stages (DeferredAdvection).
 //   BulkViscosity (when a material has one): q_p after UpdateStress, sigma - q 1 around P2G.
 //   LocalDamping (scene key damping) after the grid update and the obstacles, on the free
 //   components of v_{n+1} (Anura3D manual §6.3).
@@ -28,6 +32,11 @@
 
 namespace surge {
 
+bool DeferredAdvection(const Model& model) {
+  return model.transfer == TransferScheme::kApic &&
+         (model.scheme != UpdateScheme::kUsl || AnyAntiLocking(model));
+}
+
 StepScratch StepScratchFor(const Model& model) {
   StepScratch s{};
   const bool antilocking = AnyAntiLocking(model);
@@ -35,9 +44,12 @@ StepScratch StepScratchFor(const Model& model) {
   // USL with nothing between G2P and the stress update that reads L_p: the update runs inside
   // G2P, run by run, and L_p is never stored (GridToParticleStressStage).
   s.velocity_gradient = !(usl && !antilocking && !AnyBulkViscosity(model));
-  s.x_n = !usl || antilocking;  // MUSL's x_{n+1}; USL keeps x_n for the anti-locking's grid
+  // MUSL's x_{n+1}; USL keeps x_n for the anti-locking's grid; neither with APIC (deferred).
+  s.x_n = (!usl || antilocking) && !DeferredAdvection(model);
   s.theta = s.tensor = s.inv_stretch = s.theta_bar = false;
   s.shift = AnyParticleShifting(model);
+  s.node_reaction = !model.sensors.empty();  // RebuildGrid: SparseGrid::keep_reaction
+  s.node_momentum = !usl;                    // RemapMomentum's p_i beside v_{i,n}
   for (const AntiLocking& a : model.antilocking) {
     if (a.method == AntiLockingMethod::kNone) continue;
     const bool full = a.method == AntiLockingMethod::kHybrid ||
@@ -78,16 +90,28 @@ Pipeline MakePipeline(const Model& model) {
   // The delta-correction's shift from x_n and the grid binned there; made after G2P.
   const bool shifting = AnyParticleShifting(model);
   if (shifting) p.push_back({Stage::kParticleShifting, ParticleShiftComputeStage});
+  const bool defer = DeferredAdvection(model);
   if (fused) {
     p.push_back({Stage::kGridToParticle, GridToParticleStressStage});          // (2.17)-(2.22)
   } else if (model.scheme == UpdateScheme::kUsl) {
     p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)
-                 antilocking ? GridToParticleUslKeepStage : GridToParticleUslStage});
+                 !antilocking ? GridToParticleUslStage
+                 : defer      ? GridToParticleUslDeferStage
+                              : GridToParticleUslKeepStage});
   } else {
     p.push_back({Stage::kGridToParticle, GridToParticleMuslStage});            // (2.22)
     p.push_back({Stage::kRemapMomentum, RemapMomentumStage});                  // Sulsky 1995
     p.push_back({Stage::kVelocityGradient, VelocityGradientStage});            // (2.17)
   }
+  // The stress stages right after G2P: the stages that follow them (shift, obstacle projection,
+  // rigid bodies, sensors) read neither L_p, F nor the stress, and the stress stages read neither
+  // the positions they move nor the grid reactions; with deferred advection the anti-locking's
+  // shape functions still see x_n.
+  if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
+  if (!fused) p.push_back({Stage::kUpdateStress, UpdateStressStage});          // (2.18)-(2.20)
+  if (AnyStressAveraging(model))  // Table 4.1 steps 6-7, timed with the strain projection
+    p.push_back({Stage::kAntiLocking, StressAveragingStage});
+  if (defer) p.push_back({Stage::kGridToParticle, AdvectStage});               // (2.16)
   if (shifting) p.push_back({Stage::kParticleShifting, ParticleShiftApplyStage});  // x_{n+1}
   if (obstacles) p.push_back({Stage::kObstacleProjection, ObstacleProjectionStage});
   const bool dynamic = std::any_of(model.obstacles.begin(), model.obstacles.end(), [](const Obstacle& o) {
@@ -95,10 +119,7 @@ Pipeline MakePipeline(const Model& model) {
   });
   if (dynamic) p.push_back({Stage::kRigidBodies, RigidBodiesStage});             // Bullet
   if (!model.sensors.empty()) p.push_back({Stage::kSensors, SensorsStage});  // all reactions in
-  if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
-  if (!fused) p.push_back({Stage::kUpdateStress, UpdateStressStage});          // (2.18)-(2.20)
-  if (AnyStressAveraging(model))  // Table 4.1 steps 6-7, timed with the strain projection
-    p.push_back({Stage::kAntiLocking, StressAveragingStage});
+  // After the obstacle projection: its time-step bound reads the particle speeds.
   if (bulk_viscosity) p.push_back({Stage::kBulkViscosity, BulkViscosityRateStage});  // q_p
   p.push_back({Stage::kDomainExit, DomainExitStage});
   p.push_back({Stage::kCheckState, CheckStateStage});

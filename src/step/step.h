@@ -45,6 +45,13 @@ Pipeline MakePipeline(const Model& model);
 // estimate's share of Workspace and AntiLockingScratch).
 StepScratch StepScratchFor(const Model& model);
 
+// Whether G2P leaves the particles at x_n and AdvectStage moves them after the stress stages:
+// APIC where a stage after G2P still needs x_n (MUSL's re-map and velocity gradient, the
+// anti-locking's shape functions). APIC's particle velocity is the grid's, v_p = sum N v_{i,n+1}
+// (Jiang et al. 2015, eq. (8)), so x_n + dt v_p is G2P's own x_{n+1} (2.16), bitwise, and no
+// x_{n+1} array (24 bytes per particle) is needed. FLIP's v_p is not the grid's: it keeps one.
+bool DeferredAdvection(const Model& model);
+
 // Time step for the next step: CFL rule dt = C dx / max_p (c_p + |v_p|) (spec §1.7) and the
 // viscous limit (ViscousTimeStep), bounded by max_dt, the fixed override and the remaining time
 // to Model::time.end. Within 10 CFL steps of the end the rest is split into equal steps (no

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "core/check.h"
 #include "core/parallel.h"
 #include "core/simd.h"
 #include "transfer/dispatch.h"
@@ -63,7 +64,7 @@ enum class G2PMode { kFlip, kPicFlip, kApic };
 template <int kDim, class K, G2PMode kMode>
 void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& grid,
                   Particles& P, std::vector<Mat3>* velocity_gradient, std::vector<Vec3>* x_new,
-                  const GradientSink* sink) {
+                  const GradientSink* sink, bool advect) {
   using Pad = BlockPad<kDim, K>;
   const Real alpha = kMode == G2PMode::kFlip ? 1.0 : model.flip_ratio;
   ParallelFor(grid.runs.size(), 1, [&](size_t r) {
@@ -237,6 +238,7 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
         (*velocity_gradient)[p] = L;
       else if (sink)
         run_gradient[s - run.begin] = L;
+      if (!advect) continue;  // AdvectParticles (APIC: v_p = v_pic)
       const Vec3 xn = x + ctx.dt * v_pic;  // x_{n+1} = x_n + sum N dx_i, dx_i = dt v_{n+1} (2.16)
       if (x_new)
         (*x_new)[p] = xn;
@@ -279,24 +281,32 @@ void GradientBlocks(const StepContext& ctx, const SparseGrid& grid, const Partic
 
 void GridToParticle(const Model& model, const StepContext& ctx, const SparseGrid& grid,
                     Particles& particles, std::vector<Mat3>* velocity_gradient,
-                    std::vector<Vec3>* x_new, const GradientSink* sink) {
+                    std::vector<Vec3>* x_new, const GradientSink* sink, bool advect) {
+  SURGE_CHECK(advect || (model.transfer == TransferScheme::kApic && !x_new),
+              "deferred advection needs APIC (x += dt v_p)");
   if (velocity_gradient) velocity_gradient->resize(particles.size());
   if (x_new) x_new->resize(particles.size());
   DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
     switch (model.transfer) {
       case TransferScheme::kFlip:
         GatherBlocks<kDim, K, G2PMode::kFlip>(model, ctx, grid, particles, velocity_gradient,
-                                              x_new, sink);
+                                              x_new, sink, advect);
         break;
       case TransferScheme::kPicFlip:
         GatherBlocks<kDim, K, G2PMode::kPicFlip>(model, ctx, grid, particles, velocity_gradient,
-                                                 x_new, sink);
+                                                 x_new, sink, advect);
         break;
       case TransferScheme::kApic:
         GatherBlocks<kDim, K, G2PMode::kApic>(model, ctx, grid, particles, velocity_gradient,
-                                              x_new, sink);
+                                              x_new, sink, advect);
         break;
     }
+  });
+}
+
+void AdvectParticles(const StepContext& ctx, Particles& P) {
+  ParallelChunks(P.size(), [&](size_t, size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) P.x[p] = P.x[p] + ctx.dt * P.v[p];  // (2.16)
   });
 }
 

@@ -105,14 +105,14 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
       const size_t i = b * size_t(grid.block_nodes) + size_t(l);
       const Real m = grid.mass[i];
       if (m <= 0) {
-        grid.velocity[i].setZero();
+        grid.momentum[i].setZero();  // v_{i,n}: momentum's buffer becomes `velocity` below
         grid.velocity_new[i].setZero();
         if (keep_reaction) grid.reaction[i].setZero();
         continue;
       }
       const Vec3 v = grid.momentum[i] / m;                        // (2.13)
       const Vec3 vu = v + ctx.dt * (grid.force[i] / m + ctx.gravity);  // (2.13)-(2.14)
-      grid.velocity[i] = v;
+      grid.momentum[i] = v;  // in place: p_i is not read again (SparseGrid::momentum)
       Vec3 vc = vu;
       if (wall_count > 0) {
         const Vec3i node = grid.block_origin[b] + grid.LocalCoord(l);
@@ -143,6 +143,9 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
       if (keep_reaction) grid.reaction[i] = m * (vu - vc) / ctx.dt;  // walls' share; 0 elsewhere
     }
   });
+  // The buffer now holds v_{i,n}: it becomes `velocity`, and `momentum` takes velocity's old
+  // buffer (empty but in MUSL, whose re-map fills it; BuildTopology swaps them back).
+  grid.velocity.swap(grid.momentum);
   report = WallReport{};
   report.max_elevation = -std::numeric_limits<Real>::infinity();
   for (size_t b = 0; b < nb; ++b) {

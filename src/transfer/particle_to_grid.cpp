@@ -290,7 +290,9 @@ void ParticleToGrid(const Model& model, const StepContext& ctx, const Particles&
 
 void RemapMomentum(const Model& model, const StepContext& ctx, const Particles& particles,
                    SparseGrid& grid) {
-  std::fill(grid.momentum.begin(), grid.momentum.end(), Vec3::Zero());
+  // The grid update handed momentum's buffer to `velocity` (SparseGrid::momentum), which the
+  // MUSL ghost nodes still read: a second buffer, reused from step to step.
+  grid.momentum.assign(grid.mass.size(), Vec3::Zero());
   ScatterDispatch<false>(model, ctx, particles, grid);
   ApplyRemappedVelocity(model, ctx, grid);
 }

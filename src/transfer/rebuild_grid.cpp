@@ -80,6 +80,7 @@ void FindOwnerBlocks(const Particles& particles, Real inv_dx, SparseGrid& grid) 
 void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& grid) {
   const Real inv_dx = 1.0 / model.dx;
   grid.SetDimension(model.dim);  // 2-D blocks hold only their z = 0 node plane
+  grid.keep_reaction = !model.sensors.empty();  // the nodal reaction is read by sensors only
   DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
     ComputeRequests<kDim, K>(particles, inv_dx, grid);
   });

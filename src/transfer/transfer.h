@@ -42,8 +42,9 @@ struct WallReport {
 
 // Grid solve (2.13)-(2.14) and domain walls (seed Planar / Fixed nodes, spec §5.3): v_n = p/m,
 // v_{n+1} = v_n + dt (f/m + g), then the wall constraints on v_{n+1}. Nodes with no mass get
-// zero velocity. Reads mass, momentum, force. Writes velocity, velocity_new, reaction (the
-// walls' share), report.
+// zero velocity. Reads mass, momentum, force. Writes velocity (in momentum's buffer, which it
+// takes over: momentum is left empty or stale, SparseGrid::momentum), velocity_new, reaction (the
+// walls' share; sensors only), report.
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report);
 
@@ -147,10 +148,17 @@ using GradientSink =
 // update x += dt sum N v_{n+1}. When velocity_gradient is non-null it also writes
 // L_p = sum v_{i,n+1} (x) grad N_ip (2.17) (USL); when sink is non-null it hands L_p to it run by
 // run instead. When x_new is non-null, new positions go there instead of particles.x (MUSL,
-// which still needs x_n for the re-mapped gradient).
+// which still needs x_n for the re-mapped gradient). With advect = false (APIC only) no position
+// is written: AdvectParticles moves the particles later.
 void GridToParticle(const Model& model, const StepContext& ctx, const SparseGrid& grid,
                     Particles& particles, std::vector<Mat3>* velocity_gradient,
-                    std::vector<Vec3>* x_new, const GradientSink* sink = nullptr);
+                    std::vector<Vec3>* x_new, const GradientSink* sink = nullptr,
+                    bool advect = true);
+
+// The deferred APIC position update x_{n+1} = x_n + dt v_p (2.16): v_p = sum N v_{i,n+1} is the
+// sum G2P's own update adds, so the result is G2P's bitwise. Pre: APIC G2P with advect = false
+// ran this step and nothing changed v_p since.
+void AdvectParticles(const StepContext& ctx, Particles& particles);
 
 // MUSL (Sulsky et al. 1995): re-map the updated particle momentum to the grid with the shape
 // functions of x_n, recompute v_{n+1} = p/m and re-apply the walls (no reaction logged).
