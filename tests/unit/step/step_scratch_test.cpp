@@ -67,7 +67,9 @@ void ExpectScratchAsEstimated(const std::string& material_keys, const std::strin
   EXPECT_EQ(g.velocity_new.size(), nodes);
   EXPECT_EQ(g.momentum.capacity() > 0, expected.node_momentum);
   EXPECT_EQ(g.reaction.capacity() > 0, expected.node_reaction);
-  if (expected.node_reaction) EXPECT_EQ(g.reaction.size(), nodes);
+  if (expected.node_reaction) {
+    EXPECT_EQ(g.reaction.size(), nodes);
+  }
 }
 
 TEST(StepScratchTest, EstimateNamesTheArraysEachPipelineFills) {
