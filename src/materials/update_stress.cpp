@@ -140,7 +140,7 @@ void UpdateStress(const Model& model, const StepContext& ctx,
           if (!energy) {
             // Spans of 256 (Hencky models, in pairs) or 1024 particles.
             const size_t grain = kIsElastoplastic<std::decay_t<decltype(params)>> ? 256 : 1024;
-            ParallelFor((count + grain - 1) / grain, 1, [&](size_t c) {
+            ParallelForStatic((count + grain - 1) / grain, [&](size_t c) {
               UpdateSpan(params, dt, c * grain, std::min(count, (c + 1) * grain), index, grad, P,
                          false);
             });

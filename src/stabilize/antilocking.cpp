@@ -16,6 +16,7 @@
 #include "materials/hencky.h"
 #include "materials/symmetric_eigen.h"
 #include "transfer/dispatch.h"
+#include "transfer/owned_loops.h"
 #include "transfer/stencil_loop.h"
 
 namespace surge {
@@ -73,10 +74,24 @@ void ShiftVolumetric(const StepContext& ctx, Real theta_p, Real theta_bar, Mat3&
 // particle order, then colour order). Node-based: weight N_ip m_p at every stencil node (4.29).
 // Cell-based: weight m_p at the slot of the cell's lower corner node floor(x/dx), which every
 // kernel's stencil contains (4.25). A non-finite q_p is skipped (left to CheckState).
+// flush = false: only fill buf (OrderedBlockScatter adds it with FlushSlot).
+template <class Pad>
+void FlushSlot(const SparseGrid& grid, size_t blk, const std::vector<Accum>& buf,
+               AntiLockingScratch& s, int a, int b, int c) {
+  const Accum& n = buf[Pad::Index(a, b, c)];
+  if (n.w == 0) return;
+  const long g = PaddedToGrid(grid, blk, a, b, c);
+  SURGE_ASSERT(g >= 0);
+  if (g < 0) return;
+  s.weight[g] += n.w;
+  s.weighted[g] += n.wq;
+}
+
 template <int kDim, class K, bool kNode, class Value>
 void ScatterBlock(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
                   size_t begin, size_t end, const SparseGrid& grid, size_t blk,
-                  std::vector<Accum>& buf, AntiLockingScratch& s, const Value& value) {
+                  std::vector<Accum>& buf, AntiLockingScratch& s, const Value& value,
+                  bool flush = true) {
   using Pad = BlockPad<kDim, K>;
   buf.assign(Pad::kSize, Accum{0, 0});
   const Vec3i origin = grid.block_origin[blk];
@@ -111,18 +126,10 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, const std::vector<
       a.wq += mq;
     }
   }
-  if (!any) return;
+  if (!any || !flush) return;
   for (int a = 0; a < Pad::E; ++a)
     for (int b = 0; b < Pad::E; ++b)
-      for (int c = 0; c < Pad::Ez; ++c) {
-        const Accum& n = buf[Pad::Index(a, b, c)];
-        if (n.w == 0) continue;
-        const long g = PaddedToGrid(grid, blk, a, b, c);
-        SURGE_ASSERT(g >= 0);
-        if (g < 0) continue;
-        s.weight[g] += n.w;
-        s.weighted[g] += n.wq;
-      }
+      for (int c = 0; c < Pad::Ez; ++c) FlushSlot<Pad>(grid, blk, buf, s, a, b, c);
 }
 
 // The projected value q-bar_p of the group's particles of one block, handed to apply(p, q-bar);
@@ -193,20 +200,29 @@ template <int kDim, class K, bool kNode, class Value, class Apply>
 void Project(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
              size_t begin, size_t end, const SparseGrid& grid, AntiLockingScratch& s,
              const Value& value, const Apply& apply) {
+  using Pad = BlockPad<kDim, K>;
   s.weight.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
   s.weighted.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
-  for (int colour = 0; colour < 8; ++colour) {
-    const auto& blocks = grid.colour[colour];
-    ParallelFor(blocks.size(), 1, [&](size_t i) {
-      thread_local std::vector<Accum> buf;
-      ScatterBlock<kDim, K, kNode>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s, value);
-    });
-  }
+  // Each block on the thread that owns its particles, every slot's sums in colour order.
+  thread_local std::array<std::vector<Accum>, 8> buffers;  // one per nesting level
+  OrderedBlockScatter(
+      grid, kDim,
+      [&](size_t b, int level) {
+        ScatterBlock<kDim, K, kNode>(ctx, P, x_n, begin, end, grid, b, buffers[size_t(level)], s,
+                                     value, /*flush=*/false);
+      },
+      [&](size_t b, int level, int o) {
+        const std::vector<Accum>& buf = buffers[size_t(level)];
+        ForPaddedNodesIn<Pad>(o, [&](int a, int bb, int c) { FlushSlot<Pad>(grid, b, buf, s, a, bb, c); });
+      });
   // The node (cell) means q-bar_i = sum N m q / sum N m (4.30), once per slot, in place: the gather
   // then multiplies instead of dividing at every stencil node (bitwise the same values). An empty
   // slot gives 0/0 = NaN, as the division at gather time did, and is never used with weight > 0.
-  ParallelFor(s.weighted.size(), 4096, [&](size_t g) { s.weighted[g] /= s.weight[g]; });
-  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+  const size_t per_block = size_t(grid.block_nodes);
+  ForOwnedBlocks(grid, [&](size_t b) {
+    for (size_t g = b * per_block; g < (b + 1) * per_block; ++g) s.weighted[g] /= s.weight[g];
+  });
+  ForOwnedRuns(grid, [&](size_t r) {
     GatherBlock<kDim, K, kNode>(ctx, P, x_n, begin, end, grid, grid.runs[r], s, apply);
   });
 }
@@ -508,7 +524,7 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
     // Then q^h_p = M* sum_i N_ip q-hat_i (4.32).
     constexpr int Q = F::kLinear + F::kConst;
     s.node_fit.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(Q), 0.0);
-    ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+    ForOwnedBlocks(grid, [&](size_t blk) {
       for (int l = 0; l < grid.block_nodes; ++l) {
         const size_t g = blk * size_t(grid.block_nodes) + size_t(l);
         const Real* a = &s.moments[g * M];
@@ -525,7 +541,7 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
       }
     });
     using Pad = BlockPad<kDim, K>;
-    ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+    ForOwnedRuns(grid, [&](size_t r) {
       const SparseGrid::ParticleRun run = grid.runs[r];
       const size_t blk = run.block;
       const Vec3i origin = grid.block_origin[blk];
@@ -565,7 +581,7 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
   }
   // q^h_p = M* S_p alpha_c (4.27), or for the hybrid M*_vol theta-bar_p + M*_dev S_p alpha_c
   // (4.34)-(4.35).
-  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+  ForOwnedRuns(grid, [&](size_t r) {
     const SparseGrid::ParticleRun run = grid.runs[r];
     const size_t blk = run.block;
     const Vec3i origin = grid.block_origin[blk];
@@ -705,7 +721,7 @@ void SmoothVolumetricStrain(const StepContext& ctx, const Particles& P, const st
     });
   }
   // (6.36)-(6.37): the cell's mean of its corner nodes replaces the particle's volumetric strain.
-  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+  ForOwnedRuns(grid, [&](size_t r) {
     const SparseGrid::ParticleRun run = grid.runs[r];
     const size_t blk = run.block;
     const Vec3i origin = grid.block_origin[blk];

@@ -9,6 +9,7 @@
 
 #include "core/check.h"
 #include "core/parallel.h"
+#include "transfer/owned_loops.h"
 #include "transfer/stencil_loop.h"
 
 namespace surge {
@@ -107,7 +108,7 @@ void Compute(const Model& model, const StepContext& ctx, const std::vector<Mater
   // E_i = max(0, V~_i - V_i), and sum E^2 per block, added in block order.
   s.partial.assign(grid.block_count(), 0.0);
   const int nz = kDim == 3 ? kBlockDim : 1;
-  ParallelFor(grid.block_count(), 1, [&](size_t blk) {
+  ForOwnedBlocks(grid, [&](size_t blk) {
     const Vec3i origin = grid.block_origin[blk];
     Real sum = 0;
     for (int a = 0; a < kBlockDim; ++a)
@@ -127,7 +128,7 @@ void Compute(const Model& model, const StepContext& ctx, const std::vector<Mater
   for (Real v : s.partial) excess_sq += v;
   s.excess_sq = excess_sq;
   s.shift.resize(P.size());
-  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+  ForOwnedRuns(grid, [&](size_t r) {
     GatherGradient<kDim>(model, ctx, groups, P, grid, grid.runs[r], s.excess, s.shift);
   });
   // sum |g_p|^2 in fixed particle chunks (the runs depend on the thread count).
@@ -140,7 +141,7 @@ void Compute(const Model& model, const StepContext& ctx, const std::vector<Mater
   Real grad_sq = 0;
   for (Real v : s.partial) grad_sq += v;
   const Real b0 = grad_sq > 0 ? excess_sq / grad_sq : 0;  // Newton step on sum E^2
-  ParallelFor(P.size(), 4096, [&](size_t p) { s.shift[p] *= -b0; });
+  ParallelForStatic(P.size(), [&](size_t p) { s.shift[p] *= -b0; });
 }
 
 }  // namespace
@@ -207,7 +208,7 @@ void ComputeParticleShift(const Model& model, const StepContext& ctx,
 
 void ApplyParticleShift(const Model& model, Particles& particles, const ShiftingScratch& scratch) {
   SURGE_CHECK(scratch.shift.size() == particles.size(), "particle shift of every particle");
-  ParallelFor(particles.size(), 4096, [&](size_t p) {
+  ParallelForStatic(particles.size(), [&](size_t p) {
     const Vec3 x = particles.x[p] + scratch.shift[p];
     for (int d = 0; d < model.dim; ++d)
       if (!(x[d] > model.domain_min[d] && x[d] < model.domain_max[d])) return;

@@ -36,8 +36,9 @@ void GridToParticleStressStage(const Model&, const StepContext&, State&, Workspa
 void GridToParticleMuslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void RemapMomentumStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void VelocityGradientStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
-// USL with anti-locking: G2P writes L_p and x_{n+1} to scratch, then commits x_{n+1} by a swap,
-// so that (as after MUSL's VelocityGradient) Workspace::x_new holds x_n for AntiLocking.
+// USL with anti-locking and FLIP or PIC-FLIP (APIC defers instead, below): G2P writes L_p and
+// x_{n+1} to scratch, then commits x_{n+1} by a swap, so that (as after MUSL's VelocityGradient)
+// Workspace::x_new holds x_n for AntiLocking.
 void GridToParticleUslKeepStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // USL with anti-locking and APIC (DeferredAdvection): G2P writes v_p, C_p and L_p and leaves the
 // particles at x_n; AdvectStage moves them to x_{n+1} = x_n + dt v_p after the stress stages.

@@ -8,6 +8,7 @@
 #include "core/parallel.h"
 #include "core/simd.h"
 #include "transfer/dispatch.h"
+#include "transfer/owned_loops.h"
 #include "transfer/stencil_loop.h"
 #include "transfer/transfer.h"
 
@@ -67,7 +68,7 @@ void GatherBlocks(const Model& model, const StepContext& ctx, const SparseGrid& 
                   const GradientSink* sink, bool advect) {
   using Pad = BlockPad<kDim, K>;
   const Real alpha = kMode == G2PMode::kFlip ? 1.0 : model.flip_ratio;
-  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+  ForOwnedRuns(grid, [&](size_t r) {
     const SparseGrid::ParticleRun run = grid.runs[r];
     const size_t blk = run.block;
     // Linear APIC also reads v_{i,n} (the affine increment below).
@@ -253,7 +254,7 @@ template <int kDim, class K>
 void GradientBlocks(const StepContext& ctx, const SparseGrid& grid, const Particles& P,
                     std::vector<Mat3>& velocity_gradient) {
   using Pad = BlockPad<kDim, K>;
-  ParallelFor(grid.runs.size(), 1, [&](size_t r) {
+  ForOwnedRuns(grid, [&](size_t r) {
     const SparseGrid::ParticleRun run = grid.runs[r];
     const size_t blk = run.block;
     thread_local std::vector<NodeV1> halo;

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "core/parallel.h"
+#include "transfer/owned_loops.h"
 #include "transfer/transfer.h"
 #include "transfer/walls.h"
 
@@ -98,7 +99,7 @@ void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& 
   // Per-block partial reactions, summed in block order afterwards (deterministic).
   std::vector<SparseGrid::WallPartial>& partial = grid.wall_partials;
   partial.assign(nb, {});
-  ParallelFor(nb, 4, [&](size_t b) {
+  ForOwnedBlocks(grid, [&](size_t b) {
     auto& part = partial[b];
     part[kMaxElevation] = -std::numeric_limits<Real>::infinity();
     for (int l = 0; l < grid.block_nodes; ++l) {
@@ -318,7 +319,7 @@ namespace {
 template <bool kBalance>
 void DampNodes(const StepContext& ctx, SparseGrid& grid, DampingBalance* balance) {
   const Real alpha = ctx.damping;
-  ParallelFor(grid.block_count(), 4, [&](size_t b) {
+  ForOwnedBlocks(grid, [&](size_t b) {
     [[maybe_unused]] Real unbalanced = 0, external = 0;
     for (int l = 0; l < grid.block_nodes; ++l) {
       const size_t i = b * size_t(grid.block_nodes) + size_t(l);
@@ -359,7 +360,7 @@ void ApplyRemappedVelocity(const Model& model, const StepContext& ctx, SparseGri
   WallPlane walls[kFaceCount];
   const int wall_count = ActiveWalls(model, walls);
   const Real tolerance = 1e-9 * ctx.dx;  // node-on-wall test, robust to round-off of i*dx
-  ParallelFor(grid.block_count(), 4, [&](size_t b) {
+  ForOwnedBlocks(grid, [&](size_t b) {
     for (int l = 0; l < grid.block_nodes; ++l) {
       const size_t i = b * size_t(grid.block_nodes) + size_t(l);
       const Real m = grid.mass[i];

@@ -1,14 +1,18 @@
 // P2G (Mast 2013 eq. (2.12)): mass, momentum (+ APIC affine term), internal and traction forces.
-// Blocks are processed colour by colour; a block accumulates its particles into a padded local
-// buffer and adds it into itself and its 7 upper neighbours (no atomics, fixed summation order).
+// A block accumulates its particles into a padded local buffer and adds it into itself and its 7
+// upper neighbours, every node in colour order (no atomics on the sums, fixed summation order):
+// on one thread (and with per-body fields) colour by colour, on more each block on the thread
+// that owns its particles (OrderedBlockScatter, transfer/owned_loops.h).
 
 #include <algorithm>
+#include <array>
 #include <type_traits>
 
 #include "core/check.h"
 #include "core/parallel.h"
 #include "core/simd.h"
 #include "transfer/dispatch.h"
+#include "transfer/owned_loops.h"
 #include "transfer/stencil_loop.h"
 #include "transfer/transfer.h"
 
@@ -53,6 +57,23 @@ void FlushFields(SparseGrid& grid, size_t blk, const std::vector<FieldAccum>& bu
   }
 }
 
+// Adds padded node (a, b, c) of a block's sums into the grid (skipped when all its sums are zero).
+template <class Pad, bool kFull>
+void FlushNode(SparseGrid& grid, size_t blk, const std::vector<NodeAccum>& buf, int a, int b, int c) {
+  const NodeAccum& n = buf[Pad::Index(a, b, c)];
+  if (n.v[0][0] == 0 && n.v[0][1] == 0 && n.v[1][0] == 0 && n.v[1][1] == 0 && n.v[2][0] == 0 &&
+      n.v[2][1] == 0 && n.v[3][0] == 0)
+    return;
+  const long g = PaddedToGrid(grid, blk, a, b, c);
+  SURGE_ASSERT(g >= 0);
+  if (g < 0) return;
+  grid.momentum[g] += Vec3(n.v[0][1], n.v[1][0], n.v[1][1]);
+  if constexpr (kFull) {
+    grid.mass[g] += n.v[0][0];
+    grid.force[g] += Vec3(n.v[2][0], n.v[2][1], n.v[3][0]);
+  }
+}
+
 // kFull: mass, momentum and force; otherwise momentum only (MUSL re-map). kFields: one padded
 // buffer per velocity field (body_field maps a particle's body to its field), written to the
 // grid's field arrays and summed into the common field (Anura3D manual (6.1)-(6.3): the common
@@ -60,10 +81,11 @@ void FlushFields(SparseGrid& grid, size_t blk, const std::vector<FieldAccum>& bu
 // [xlo, xhi): the slab of padded x node columns this call accumulates and writes (all: 0 to
 // Pad::E). Calls on disjoint slabs of one block may run in parallel: each node still sums the
 // block's particles in their sorted order, so the result is the same bitwise for any split.
+// flush = false: only accumulate into buf (OrderedBlockScatter then adds it into the grid).
 template <int kDim, class K, bool kApic, bool kFull, bool kFields = false>
 void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, size_t blk,
                   std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>>& buf,
-                  const int* body_field, int xlo, int xhi) {
+                  const int* body_field, int xlo, int xhi, bool flush = true) {
   using Pad = BlockPad<kDim, K>;
   using Accum = std::conditional_t<kFields, FieldAccum, NodeAccum>;
   const int fields = kFields ? grid.field_count : 1;
@@ -195,25 +217,13 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
       }
     }
   }
+  if (!flush) return;
   if constexpr (kFields) {
     FlushFields<Pad>(grid, blk, buf, xlo, xhi);
   } else {
     for (int a = xlo; a < xhi; ++a)
       for (int b = 0; b < Pad::E; ++b)
-        for (int c = 0; c < Pad::Ez; ++c) {
-          const NodeAccum& n = buf[Pad::Index(a, b, c)];
-          if (n.v[0][0] == 0 && n.v[0][1] == 0 && n.v[1][0] == 0 && n.v[1][1] == 0 &&
-              n.v[2][0] == 0 && n.v[2][1] == 0 && n.v[3][0] == 0)
-            continue;
-          const long g = PaddedToGrid(grid, blk, a, b, c);
-          SURGE_ASSERT(g >= 0);
-          if (g < 0) continue;
-          grid.momentum[g] += Vec3(n.v[0][1], n.v[1][0], n.v[1][1]);
-          if constexpr (kFull) {
-            grid.mass[g] += n.v[0][0];
-            grid.force[g] += Vec3(n.v[2][0], n.v[2][1], n.v[3][0]);
-          }
-        }
+        for (int c = 0; c < Pad::Ez; ++c) FlushNode<Pad, kFull>(grid, blk, buf, a, b, c);
   }
 }
 
@@ -222,6 +232,21 @@ void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& gri
              const int* body_field) {
   using Pad = BlockPad<kDim, K>;
   const size_t threads = WorkerThreads();
+  if constexpr (!kFields) {
+    // Single field: each block on the thread that owns its particles (OrderedBlockScatter).
+    thread_local std::array<std::vector<NodeAccum>, 8> buffers;  // one per nesting level
+    OrderedBlockScatter(
+        grid, kDim,
+        [&](size_t b, int level) {
+          ScatterBlock<kDim, K, kApic, kFull>(ctx, particles, grid, b, buffers[size_t(level)],
+                                              nullptr, 0, Pad::E, /*flush=*/false);
+        },
+        [&](size_t b, int level, int o) {
+          const std::vector<NodeAccum>& buf = buffers[size_t(level)];
+          ForPaddedNodesIn<Pad>(o, [&](int a, int bb, int c) { FlushNode<Pad, kFull>(grid, b, buf, a, bb, c); });
+        });
+    return;
+  }
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
     // A colour with few blocks (small runs: a 1e4-particle column has one or two per colour)

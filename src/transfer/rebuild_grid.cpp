@@ -3,6 +3,7 @@
 
 #include "core/parallel.h"
 #include "transfer/dispatch.h"
+#include "transfer/owned_loops.h"
 #include "transfer/transfer.h"
 
 namespace surge {
@@ -91,6 +92,16 @@ void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& gri
   });
 
   BinParticles(grid);
+  // The P2G sums start at zero, cleared block by block by the thread that then adds the block's
+  // particles into them (a serial clear of 56 bytes per node was a tenth of a small run's grid
+  // rebuild).
+  const size_t per_block = size_t(grid.block_nodes);
+  ForOwnedBlocks(grid, [&](size_t b) {
+    const ptrdiff_t begin = ptrdiff_t(b * per_block), end = ptrdiff_t((b + 1) * per_block);
+    std::fill(grid.mass.begin() + begin, grid.mass.begin() + end, 0.0);
+    std::fill(grid.momentum.begin() + begin, grid.momentum.begin() + end, Vec3::Zero());
+    std::fill(grid.force.begin() + begin, grid.force.begin() + end, Vec3::Zero());
+  });
 }
 
 void BinParticles(SparseGrid& grid) {
