@@ -8,9 +8,12 @@
 
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <thread>
 
 #include "scene/scene.h"
 #include "step/step.h"
@@ -236,6 +239,40 @@ BENCHMARK_CAPTURE(BM_Column, dp_3d_4M, 3, kSmoothCap)
 BENCHMARK_CAPTURE(BM_Column, dp_2d, 2, kSmoothCap)->Apply(ColumnArgs);
 BENCHMARK_CAPTURE(BM_Column, elastic_3d, 3, kRubber)->Apply(ColumnArgs);
 BENCHMARK_CAPTURE(BM_Column, water_3d, 3, kWater)->Apply(ColumnArgs);
+
+// The machine, not Surge: how long one cache line takes to go from one core to the other and
+// back (two threads hand a counter back and forth; counter: ns per round trip). On the 2-vCPU
+// EPYC VM this is about 420 ns, which is why the step's loops keep each thread on the particles
+// and blocks it owns (src/transfer/owned_loops.h, docs/benchmarks.md sixteenth increment).
+void BM_CoreToCoreRoundTrip(benchmark::State& state) {
+  if (std::thread::hardware_concurrency() < 2) {
+    state.SkipWithError("needs two cores (the threads spin)");
+    return;
+  }
+  alignas(64) std::atomic<int64_t> flag{0};
+  constexpr int64_t kTrips = 200000;
+  double seconds = 0;
+  for (auto _ : state) {
+    flag.store(0);
+    const auto start = std::chrono::steady_clock::now();
+    std::thread other([&] {
+      for (int64_t i = 0; i < kTrips; ++i) {
+        while (flag.load(std::memory_order_acquire) != 2 * i + 1) {
+        }
+        flag.store(2 * i + 2, std::memory_order_release);
+      }
+    });
+    for (int64_t i = 0; i < kTrips; ++i) {
+      flag.store(2 * i + 1, std::memory_order_release);
+      while (flag.load(std::memory_order_acquire) != 2 * i + 2) {
+      }
+    }
+    other.join();
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  state.counters["ns_per_round_trip"] = seconds * 1e9 / (double(kTrips) * double(state.iterations()));
+}
+BENCHMARK(BM_CoreToCoreRoundTrip)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace surge
