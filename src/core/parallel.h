@@ -55,7 +55,8 @@ void ParallelChunks(size_t n, const F& f) {
   tbb::parallel_for(
       tbb::blocked_range<size_t>(0, kReductionChunks, 1),
       [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t c = r.begin(); c != r.end(); ++c) f(c, n * c / kReductionChunks, n * (c + 1) / kReductionChunks);
+        for (size_t c = r.begin(); c != r.end(); ++c)
+          f(c, n * c / kReductionChunks, n * (c + 1) / kReductionChunks);
       },
       tbb::static_partitioner());
 }

@@ -63,12 +63,7 @@ void ForEachPart(size_t parts, const F& f) {
     f(size_t{0});
     return;
   }
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, parts, 1),
-      [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t t = r.begin(); t != r.end(); ++t) f(t);
-      },
-      tbb::static_partitioner());
+  ParallelForStatic(parts, f);
 }
 
 // f(b) for every block b, each on the thread that owns b's particles.
