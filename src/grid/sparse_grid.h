@@ -99,6 +99,8 @@ struct SparseGrid {
   // --- Scratch reused by RebuildGrid (no allocation per step after warm-up). ---
   std::vector<std::vector<BlockRequest>> chunk_requests;
   std::vector<BlockRequest> requests;
+  std::vector<Vec3i> request_blocks;   // requests' block coordinates, for LookupBlocks
+  std::vector<int32_t> request_block;  // block index of each request
   std::vector<uint32_t> chunk_cursor;
   using WallPartial = std::array<Real, 45>;  // 6 faces x 7 sums + 3 (grid_update.cpp)
   std::vector<WallPartial> wall_partials;    // per-block wall reactions (grid_update.cpp)

@@ -66,9 +66,10 @@ void UpdateOne(const Pm& params, Real dt, size_t p, const Mat3& L, Particles& P)
 // at a time (HenckyTrialStates: two spectral decompositions side by side). Each particle's result
 // is bitwise what the one-particle path gives, so neither the thread count, the split into spans
 // nor the pairing changes a result.
+// With `checks`, each particle goes through checks->Test after its update.
 template <class Pm, class Index, class Grad>
 Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const Index& index,
-                const Grad& grad, Particles& P, bool energy) {
+                const Grad& grad, Particles& P, bool energy, EndChecks* checks = nullptr) {
   // P_n of particle p, read before its update (F_n, sigma_n), or P_{n+1} after it.
   const auto power_of = [&](size_t p, const Mat3& L, Real J) {
     return energy ? StressPowerOf(P.stress[p], L, J, P.volume0[p]) : 0.0;
@@ -109,6 +110,7 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
         P.elastic_b[p[i]] = b[i];
         P.stress[p[i]] = stress;
         if (energy) sum += before[i] + power_of(p[i], grad(k0 + i), J);
+        if (checks) checks->Test(P, p[i], J);
       }
     }
   } else {
@@ -117,7 +119,11 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
       const Mat3& L = grad(k);
       const Real before = energy ? power_of(p, L, P.F[p].determinant()) : 0.0;
       UpdateOne(params, dt, p, L, P);
-      if (energy) sum += before + power_of(p, L, P.F[p].determinant());
+      if (energy || checks) {
+        const Real J = P.F[p].determinant();
+        if (energy) sum += before + power_of(p, L, J);
+        if (checks) checks->Test(P, p, J);
+      }
     }
   }
   return sum;
@@ -158,7 +164,8 @@ void UpdateStress(const Model& model, const StepContext& ctx,
 }
 
 Real UpdateStressOfRun(const Model& model, const StepContext& ctx, const uint32_t* ids,
-                       const Mat3* velocity_gradient, size_t n, Particles& P, bool energy) {
+                       const Mat3* velocity_gradient, size_t n, Particles& P, bool energy,
+                       EndChecks* checks) {
   Real sum = 0;
   const auto index = [&](size_t k) { return size_t(ids[k]); };
   const auto grad = [&](size_t k) -> const Mat3& { return velocity_gradient[k]; };
@@ -168,7 +175,7 @@ Real UpdateStressOfRun(const Model& model, const StepContext& ctx, const uint32_
     while (end < n && P.material[ids[end]] == material) ++end;
     sum += std::visit(
         [&](const auto& params) {
-          return UpdateSpan(params, ctx.dt, begin, end, index, grad, P, energy);
+          return UpdateSpan(params, ctx.dt, begin, end, index, grad, P, energy, checks);
         },
         model.materials[size_t(material)].params);
     begin = end;

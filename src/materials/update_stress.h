@@ -3,6 +3,7 @@
 #pragma once
 #include <vector>
 
+#include "core/end_checks.h"
 #include "core/model.h"
 #include "core/state.h"
 #include "core/step_context.h"
@@ -22,9 +23,11 @@ void UpdateStress(const Model& model, const StepContext& ctx,
 // The same update for the particles ids[0..n) with gradients velocity_gradient[0..n) (one run of
 // G2P: the step fuses the stress update into G2P where nothing else reads L, docs/architecture.md).
 // Particles may belong to different materials. With `energy` returns their P_n + P_{n+1} [W],
-// summed in k order; else 0.
+// summed in k order; else 0. With `checks`, each particle goes through checks->Test right after
+// its update (core/end_checks.h).
 Real UpdateStressOfRun(const Model& model, const StepContext& ctx, const uint32_t* ids,
-                       const Mat3* velocity_gradient, size_t n, Particles& particles, bool energy);
+                       const Mat3* velocity_gradient, size_t n, Particles& particles, bool energy,
+                       EndChecks* checks = nullptr);
 
 // Material history consistent with a prescribed initial Cauchy stress at F = I (a geostatic
 // start): b^e from the elastic compliance for J2, identity otherwise; history slots zero.

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "core/end_checks.h"
 #include "core/parallel.h"
 #include "materials/update_stress.h"
 #include "step/stages.h"
@@ -115,15 +116,24 @@ void GridToParticleUslStage(const Model& m, const StepContext& c, State& s, Work
   GridToParticle(m, c, w.grid, s.particles, &w.velocity_gradient, nullptr);
 }
 
-void GridToParticleStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
-                               StepReport&) {
+namespace {
+void FusedGridToParticleStress(const Model& m, const StepContext& c, State& s, Workspace& w,
+                               bool end_checks) {
   // The internal work of UpdateStressStage, W += dt/2 (P_n + P_{n+1}), from each run's sum, added
   // in run order (the runs depend on the grid only, not on the thread count).
   const bool energy = m.output.energy;
-  w.run_power.assign(energy ? w.grid.runs.size() : 0, 0.0);
+  const size_t runs = w.grid.runs.size();
+  w.run_power.assign(energy ? runs : 0, 0.0);
+  w.run_clean.assign(end_checks ? runs : 0, 0);
+  const DomainBox box = DomainBox::Of(m);
   const GradientSink sink = [&](size_t run, const uint32_t* ids, const Mat3* L, size_t n) {
-    const Real power = UpdateStressOfRun(m, c, ids, L, n, s.particles, energy);  // (2.18)-(2.20)
+    // The tests run on each particle right after its update, while it is in cache: its state is
+    // final for this step (see GridToParticleStressCheckStage).
+    EndChecks checks{box};
+    const Real power = UpdateStressOfRun(m, c, ids, L, n, s.particles, energy,  // (2.18)-(2.20)
+                                         end_checks ? &checks : nullptr);
     if (energy) w.run_power[run] = power;
+    if (end_checks) w.run_clean[run] = checks.clean;
   };
   GridToParticle(m, c, w.grid, s.particles, nullptr, nullptr, &sink);
   if (energy) {
@@ -131,6 +141,20 @@ void GridToParticleStressStage(const Model& m, const StepContext& c, State& s, W
     for (Real power : w.run_power) total += power;
     s.internal_work += 0.5 * c.dt * total;
   }
+  // The runs cover every particle once (BinParticles).
+  w.end_checks_passed =
+      end_checks && std::all_of(w.run_clean.begin(), w.run_clean.end(), [](uint8_t v) { return v; });
+}
+}  // namespace
+
+void GridToParticleStressStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                               StepReport&) {
+  FusedGridToParticleStress(m, c, s, w, false);
+}
+
+void GridToParticleStressCheckStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                                    StepReport&) {
+  FusedGridToParticleStress(m, c, s, w, true);
 }
 
 namespace {
@@ -309,16 +333,12 @@ void DomainExitStage(const Model& m, const StepContext&, State& s, Workspace& w,
                      StepReport& r) {
   Particles& P = s.particles;
   const size_t n = P.size();
+  r.removed_last_step = 0;
+  // Every particle inside the box, as G2P found it (GridToParticleStressCheckStage): nothing to do.
+  if (w.end_checks_passed) return;
   w.exit_flag.resize(n);
-  // The box and which of its sides are open, hoisted out of the particle loop.
-  const int dim = m.dim;
-  Real lo[3], hi[3];
-  bool open_lo[3], open_hi[3];
-  for (int d = 0; d < dim; ++d) {
-    lo[d] = m.domain_min[d], hi[d] = m.domain_max[d];
-    open_lo[d] = m.walls[2 * d].kind == WallKind::kOpen;
-    open_hi[d] = m.walls[2 * d + 1].kind == WallKind::kOpen;
-  }
+  const DomainBox box = DomainBox::Of(m);
+  const int dim = box.dim;
   std::array<uint8_t, kReductionChunks> any{};
   ParallelChunks(n, [&](size_t chunk, size_t b, size_t e) {
     uint8_t any_here = 0;
@@ -326,12 +346,12 @@ void DomainExitStage(const Model& m, const StepContext&, State& s, Workspace& w,
       uint8_t exits = 0;
       for (int d = 0; d < dim; ++d) {
         Real& xd = P.x[p][d];
-        if (xd < lo[d]) {
-          if (open_lo[d]) exits = 1;
-          else xd = lo[d];
-        } else if (xd > hi[d]) {
-          if (open_hi[d]) exits = 1;
-          else xd = hi[d];
+        if (xd < box.lo[d]) {
+          if (box.open_lo[d]) exits = 1;
+          else xd = box.lo[d];
+        } else if (xd > box.hi[d]) {
+          if (box.open_hi[d]) exits = 1;
+          else xd = box.hi[d];
         }
       }
       w.exit_flag[p] = exits;
@@ -339,7 +359,6 @@ void DomainExitStage(const Model& m, const StepContext&, State& s, Workspace& w,
     }
     any[chunk] = any_here;
   });
-  r.removed_last_step = 0;
   if (std::find(any.begin(), any.end(), 1) == any.end()) return;
   if (m.exit_policy == ExitPolicy::kStop) {
     const size_t p = size_t(std::find(w.exit_flag.begin(), w.exit_flag.end(), 1) - w.exit_flag.begin());
@@ -509,7 +528,12 @@ void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, s
 
 // Health check (DESIGN §4 item 7): NaN/Inf in v, x, F or stress, and J = det F <= 0. The healthy
 // path is one pass over the particles; the diagnostic (DescribeUnhealthy) runs only on failure.
-void CheckStateStage(const Model& m, const StepContext& ctx, State& s, Workspace&, StepReport& r) {
+void CheckStateStage(const Model& m, const StepContext& ctx, State& s, Workspace& w, StepReport& r) {
+  // Every particle passed the fast test below in G2P (GridToParticleStressCheckStage).
+  if (w.end_checks_passed) {
+    w.end_checks_passed = false;
+    return;
+  }
   const Particles& P = s.particles;
   constexpr size_t kNone = std::numeric_limits<size_t>::max();
   std::array<std::array<size_t, kFieldCount>, kReductionChunks> first;
@@ -517,13 +541,7 @@ void CheckStateStage(const Model& m, const StepContext& ctx, State& s, Workspace
   std::array<size_t, kReductionChunks> bad{};
   ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
     for (size_t p = b; p < e; ++p) {
-      // Fast path: a sum of finite numbers is finite unless it overflows, and any NaN or Inf
-      // makes it non-finite, so a finite sum with det F > 0 is a healthy particle; otherwise
-      // the exact tests below decide (an overflowing sum of finite values passes them).
-      const Real* t = P.stress[p].v;
-      const Real sum = P.v[p].sum() + P.x[p].sum() + P.F[p].sum() + t[0] + t[1] + t[2] + t[3] +
-                       t[4] + t[5];
-      if (std::isfinite(sum) && P.F[p].determinant() > 0) continue;
+      if (SurelyHealthy(P, p, P.F[p].determinant())) continue;
       int field = kFieldOk;
       if (!P.v[p].allFinite()) field = kFieldV;
       else if (!P.x[p].allFinite()) field = kFieldX;

@@ -33,6 +33,12 @@ void GridToParticleUslStage(const Model&, const StepContext&, State&, Workspace&
 // UpdateStressStage (no L array: 72 bytes per particle less; docs/benchmarks.md). Same results
 // bitwise; its clock (grid_to_particle) includes the stress update.
 void GridToParticleStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// The same, and the run's particles then pass through the domain-exit test and the fast test of
+// the health check while they are in cache: where nothing after G2P moves a particle or changes its
+// v, F or stress before DomainExitStage (no particle shifting, no obstacles), a step whose
+// particles all pass skips both stages' passes over the particles (docs/benchmarks.md).
+void GridToParticleStressCheckStage(const Model&, const StepContext&, State&, Workspace&,
+                                    StepReport&);
 void GridToParticleMuslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void RemapMomentumStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void VelocityGradientStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);

@@ -91,8 +91,12 @@ Pipeline MakePipeline(const Model& model) {
   const bool shifting = AnyParticleShifting(model);
   if (shifting) p.push_back({Stage::kParticleShifting, ParticleShiftComputeStage});
   const bool defer = DeferredAdvection(model);
+  // The stages between G2P and the domain exit that could move a particle or change v, F or the
+  // stress: with none, G2P also runs the domain-exit and health tests (stages.h).
+  const bool end_checks = !shifting && !obstacles && !defer && !AnyStressAveraging(model);
   if (fused) {
-    p.push_back({Stage::kGridToParticle, GridToParticleStressStage});          // (2.17)-(2.22)
+    p.push_back({Stage::kGridToParticle, end_checks ? GridToParticleStressCheckStage
+                                                    : GridToParticleStressStage});  // (2.17)-(2.22)
   } else if (model.scheme == UpdateScheme::kUsl) {
     p.push_back({Stage::kGridToParticle,                                       // (2.17), (2.22)
                  !antilocking ? GridToParticleUslStage

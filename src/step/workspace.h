@@ -19,6 +19,10 @@ struct Workspace {
   std::vector<Mat3> velocity_gradient;  // L_p [1/s]        written by GridToParticle / VelocityGradient
   std::vector<Vec3> x_new;              // x_{n+1} [m] (MUSL) written by GridToParticle
   std::vector<Real> run_power;          // stress power per G2P run [W] (GridToParticleStressStage)
+  // Per G2P run: every particle inside the domain box and past the health check's fast test
+  // (GridToParticleStressCheckStage); all of them: DomainExit and CheckState skip their passes.
+  std::vector<uint8_t> run_clean;
+  bool end_checks_passed = false;
   std::vector<uint8_t> exit_flag;       // scratch of DomainExit and ReorderParticles
   std::vector<uint32_t> reorder;        // scratch of ReorderParticles
   AntiLockingScratch antilocking;       // node sums of AntiLocking

@@ -1,5 +1,6 @@
 // Grid topology and particle binning, every step (DESIGN §5; spike note "Design as tested" 1-4).
 #include <algorithm>
+#include <array>
 
 #include "core/parallel.h"
 #include "transfer/dispatch.h"
@@ -24,55 +25,60 @@ Vec3i OwnerBlock(const Vec3& x, Real inv_dx, uint8_t& mask) {
   return block;
 }
 
-// Pass 1: owner block and crossing mask of every particle; per-chunk deduplicated requests.
+// Pass 1: owner block and crossing mask of every particle; per-chunk deduplicated requests. Each
+// particle's particle_block holds, for now, the index of its request within its chunk's list.
 template <int kDim, class K>
 void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) {
   const size_t n = particles.size();
   grid.chunk_requests.resize(kReductionChunks);
+  grid.particle_block.resize(n);
   ParallelChunks(n, [&](size_t chunk, size_t begin, size_t end) {
     auto& out = grid.chunk_requests[chunk];
     out.clear();
     // Direct-mapped cache of recent (block, mask) entries (spike note: "dedupe quality").
     constexpr int kCache = 64;
     BlockRequest cache[kCache];
+    int32_t cache_index[kCache];
     bool used[kCache] = {};
     BlockRequest last;
-    bool have_last = false;
+    int32_t last_index = -1;
     for (size_t p = begin; p < end; ++p) {
       uint8_t mask = 0;
       const Vec3i block = OwnerBlock<kDim, K>(particles.x[p], inv_dx, mask);
-      if (have_last && last.block == block && last.upper == mask) continue;
-      last = BlockRequest{block, mask};
-      have_last = true;
-      const unsigned h = (unsigned(block.x()) * 73856093u ^ unsigned(block.y()) * 19349663u ^
-                          unsigned(block.z()) * 83492791u ^ mask) % kCache;
-      if (used[h] && cache[h].block == block && cache[h].upper == mask) continue;
-      used[h] = true;
-      cache[h] = last;
-      out.push_back(last);
+      if (last_index < 0 || !(last.block == block && last.upper == mask)) {
+        last = BlockRequest{block, mask};
+        const unsigned h = (unsigned(block.x()) * 73856093u ^ unsigned(block.y()) * 19349663u ^
+                            unsigned(block.z()) * 83492791u ^ mask) % kCache;
+        if (used[h] && cache[h].block == block && cache[h].upper == mask) {
+          last_index = cache_index[h];
+        } else {
+          used[h] = true;
+          cache[h] = last;
+          last_index = cache_index[h] = int32_t(out.size());
+          out.push_back(last);
+        }
+      }
+      grid.particle_block[p] = last_index;
     }
   });
   grid.requests.clear();
   for (const auto& c : grid.chunk_requests) grid.requests.insert(grid.requests.end(), c.begin(), c.end());
 }
 
-// Pass 2, after the topology is built: the index of every particle's owner block. The block
-// coordinates are recomputed in slices of kSlice (a stack buffer) rather than kept from pass 1, so
-// binning holds no per-particle coordinate array (12 bytes per particle).
-template <int kDim, class K>
-void FindOwnerBlocks(const Particles& particles, Real inv_dx, SparseGrid& grid) {
-  const size_t n = particles.size();
-  grid.particle_block.resize(n);
-  ParallelChunks(n, [&](size_t, size_t begin, size_t end) {
-    constexpr size_t kSlice = 512;
-    Vec3i blocks[kSlice];
-    for (size_t first = begin; first < end; first += kSlice) {
-      const size_t count = std::min(kSlice, end - first);
-      uint8_t mask;
-      for (size_t i = 0; i < count; ++i)
-        blocks[i] = OwnerBlock<kDim, K>(particles.x[first + i], inv_dx, mask);
-      LookupBlocks(grid, blocks, count, grid.particle_block.data() + first);
-    }
+// Pass 2, after the topology is built: the index of every particle's owner block, through its
+// request (every requested block exists), so that no particle's block is computed twice.
+void FindOwnerBlocks(SparseGrid& grid) {
+  std::vector<Vec3i>& blocks = grid.request_blocks;
+  blocks.resize(grid.requests.size());
+  for (size_t r = 0; r < blocks.size(); ++r) blocks[r] = grid.requests[r].block;
+  grid.request_block.resize(blocks.size());
+  LookupBlocks(grid, blocks.data(), blocks.size(), grid.request_block.data());
+  std::array<size_t, kReductionChunks + 1> offset{};
+  for (size_t c = 0; c < kReductionChunks; ++c)
+    offset[c + 1] = offset[c] + grid.chunk_requests[c].size();
+  ParallelChunks(grid.particle_block.size(), [&](size_t chunk, size_t begin, size_t end) {
+    const int32_t* to_block = grid.request_block.data() + offset[chunk];
+    for (size_t p = begin; p < end; ++p) grid.particle_block[p] = to_block[grid.particle_block[p]];
   });
 }
 
@@ -87,9 +93,7 @@ void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& gri
   });
   BuildTopology(grid.requests, grid);
 
-  DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
-    FindOwnerBlocks<kDim, K>(particles, inv_dx, grid);
-  });
+  FindOwnerBlocks(grid);
 
   BinParticles(grid);
   // The P2G sums start at zero, cleared block by block by the thread that then adds the block's

@@ -5,11 +5,18 @@
 #include <sstream>
 
 #include "scene/scene.h"
+#include "step/stages.h"
 #include "step/step.h"
 #include "transfer/transfer.h"
 
 namespace surge {
 namespace {
+
+bool UsesFusedEndChecks(const Pipeline& pipeline) {
+  for (const PipelineStage& s : pipeline)
+    if (s.run == GridToParticleStressCheckStage) return true;
+  return false;
+}
 
 // A 0.3 x 0.2 m block moving at 3 m/s towards x+ of a unit domain whose corner is at (o, o).
 LoadedScene MovingBlock(const std::string& walls, const std::string& on_exit, double o = 0) {
@@ -69,6 +76,31 @@ TEST(DomainTest, BodyFarFromOriginCostsTheSameGrid) {
   RebuildGrid(far.model, far.state.particles, g_far);
   EXPECT_EQ(g_near.block_count(), g_far.block_count());
   EXPECT_LE(g_far.block_count(), 8u);
+}
+
+TEST(DomainTest, FusedEndChecksStillFindAnUnhealthyParticle) {
+  // The block's pipeline runs the domain-exit and health tests inside G2P (no obstacles, no
+  // anti-locking); a NaN stress spreads through P2G to the grid and back, and the health check
+  // must still stop the step and name a particle.
+  LoadedScene scene = MovingBlock("{x+: slip}", "stop");
+  ASSERT_TRUE(UsesFusedEndChecks(MakePipeline(scene.model)));
+  scene.state.particles.stress[3] = SymMat3(Mat3::Constant(std::nan("")));
+  EXPECT_EQ(RunFor(scene, 0.01), HealthStatus::kNonFinite);
+}
+
+TEST(DomainTest, FusedEndChecksOnlyWhereNothingMovesParticlesAfterGridToParticle) {
+  // An obstacle projects particles after G2P: the tests then stay in their own stages.
+  LoadedScene plain = MovingBlock("{}", "remove");
+  EXPECT_TRUE(UsesFusedEndChecks(MakePipeline(plain.model)));
+  std::ostringstream s;
+  s << "name: exit_test\ndimension: 2\ntime: {end: 1.0, cfl: 0.4}\ngrid: {cell_size: 0.1}\n"
+    << "domain: {min: [0, 0], max: [1, 1]}\n"
+    << "materials:\n  m: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e5, "
+       "poisson_ratio: 0.3}\n"
+    << "bodies:\n  - {name: b, material: m, region: {box: {min: [0.6, 0.4], max: [0.9, 0.6]}}}\n"
+    << "obstacles:\n  - {name: post, shape: {box: {min: [0.1, 0.1], max: [0.2, 0.2]}}}\n";
+  LoadedScene with_obstacle = LoadSceneFromString(s.str(), "exit_test.yaml");
+  EXPECT_FALSE(UsesFusedEndChecks(MakePipeline(with_obstacle.model)));
 }
 
 }  // namespace
