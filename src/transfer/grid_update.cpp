@@ -3,6 +3,7 @@
 // the particles (the [REC] variant of spec §1.3), and the reaction is the momentum removed:
 // R = -m_i (v_c - v_u) / dt, summed per face.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -45,20 +46,48 @@ void MarkWallContacts(const Model& model, const StepContext& ctx, const Particle
     }
     t.touched.assign(size_t(t.n1) * size_t(t.n2), 0);
   }
-  // Find the touching particles in parallel (per chunk, in particle order), mark serially: the
-  // marks are a set, so the result is the same for any thread count.
-  const size_t n = P.size();
-  ParallelChunks(n, [&](size_t chunk, size_t b, size_t e) {
+  // Touching: d <= 1.5 half, half = V0^(1/dim) / 2, tested without the root (cbrt was about 1 %
+  // of a step): d <= 0, or d^dim <= 0.75^dim V0.
+  const Real c_touch = model.dim == 3 ? 0.421875 : 0.5625;
+  const auto touches = [&](size_t p, int k) {
+    const Real d = walls[k].sign * (P.x[p][walls[k].axis] - walls[k].level);
+    return d <= 0 || (model.dim == 3 ? d * d * d : d * d) <= c_touch * P.volume0[p];
+  };
+  // Broad phase by blocks: a particle owned by block b (binned this step, RebuildGrid) has its
+  // stencil base node in the block, K::Base(x / dx) in [o, o + kBlockDim) with o the block origin,
+  // and Base(u) in (u - 2, u] for every kernel, so x / dx lies in [o, o + kBlockDim + 2) along each
+  // axis (one more cell either side below for the rounding of x / dx). No particle of a block
+  // farther than the largest touch distance, 0.75 V0max^(1/dim) (plus a rounding margin), from
+  // every wall can touch one.
+  std::array<Real, kReductionChunks> v0_part{};
+  ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
+    Real v = 0;
+    for (size_t p = b; p < e; ++p) v = std::max(v, P.volume0[p]);
+    v0_part[chunk] = v;
+  });
+  const Real v0_max = *std::max_element(v0_part.begin(), v0_part.end());
+  const Real touch_max =
+      0.75 * (model.dim == 3 ? std::cbrt(v0_max) : std::sqrt(v0_max)) * (1 + 1e-9) + 1e-12 * ctx.dx;
+  const auto near_a_wall = [&](size_t blk) {
+    for (int k = 0; k < wall_count; ++k) {
+      const int a = walls[k].axis;
+      const Real lo = (grid.block_origin[blk][a] - 1) * ctx.dx, hi = lo + (kBlockDim + 4) * ctx.dx;
+      const Real d_min = walls[k].sign > 0 ? lo - walls[k].level : walls[k].level - hi;
+      if (d_min <= touch_max) return true;
+    }
+    return false;
+  };
+  // Find the touching particles in parallel (per chunk of blocks, in block and particle order),
+  // mark serially: the marks are a set, so the result is the same for any thread count.
+  ParallelChunks(grid.block_count(), [&](size_t chunk, size_t b_begin, size_t b_end) {
     std::vector<uint32_t>& out = grid.touch_scratch[chunk];
     out.clear();
-    for (size_t p = b; p < e; ++p) {
-      // Touching: d <= 1.5 half, half = V0^(1/dim) / 2, tested without the root (cbrt was about
-      // 1 % of a step): d <= 0, or d^dim <= 0.75^dim V0.
-      const Real limit = (model.dim == 3 ? 0.421875 : 0.5625) * P.volume0[p];
-      for (int k = 0; k < wall_count; ++k) {
-        const Real d = walls[k].sign * (P.x[p][walls[k].axis] - walls[k].level);
-        if (d <= 0 || (model.dim == 3 ? d * d * d : d * d) <= limit)
-          out.push_back(uint32_t(p) * 8 + uint32_t(k));
+    for (size_t blk = b_begin; blk < b_end; ++blk) {
+      if (grid.block_begin[blk] == grid.block_begin[blk + 1] || !near_a_wall(blk)) continue;
+      for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
+        const size_t p = grid.sorted[s];
+        for (int k = 0; k < wall_count; ++k)
+          if (touches(p, k)) out.push_back(uint32_t(p) * 8 + uint32_t(k));
       }
     }
   });

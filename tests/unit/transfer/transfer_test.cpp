@@ -10,6 +10,7 @@
 
 #include "core/parallel.h"
 #include "support/test_state.h"
+#include "transfer/walls.h"
 
 namespace surge {
 namespace {
@@ -148,6 +149,46 @@ TEST(TransferTest, RebuiltTopologyEqualsAFreshOne) {
     EXPECT_TRUE(reused.block_begin == fresh.block_begin) << "step " << k;
     EXPECT_TRUE(reused.sorted == fresh.sorted) << "step " << k;
     EXPECT_TRUE(reused.mass == fresh.mass) << "step " << k;  // zeroed
+  }
+}
+
+// The walls' gap test marks the node column of every particle that touches a wall (d <= 0 or
+// d <= 0.75 V0^(1/dim)), also where the block broad phase of MarkWallContacts must look past the
+// blocks next to the wall: a few particles deep inside carry volumes large enough to touch.
+TEST(TransferTest, WallContactsMarkEveryTouchingParticlesColumn) {
+  for (int dim = 2; dim <= 3; ++dim) {
+    Model m = testing::SmallModel(dim, ShapeFunction::kQuadraticBspline, TransferScheme::kApic, 0.1);
+    m.domain_min = Vec3(-3, -3, dim == 3 ? -3 : 0);
+    m.domain_max = Vec3(3, 3, dim == 3 ? 3 : 0);
+    for (int f = 0; f < 2 * dim; ++f) m.walls[size_t(f)].kind = WallKind::kSlip;
+    State s = testing::RandomState(dim, 4000, Vec3::Zero(), 5.9, m.dx);
+    Particles& P = s.particles;
+    // Deep inside, in blocks a metre and more from every wall: 0.75 V0^(1/dim) = 3.15 m > the
+    // 2.6-3 m to the nearest wall.
+    for (size_t p = 0; p < 4; ++p) {
+      P.x[p] = Vec3(0.4 - 0.1 * Real(p), 0.05 * Real(p), 0.0);
+      P.volume0[p] = std::pow(4.2, dim);
+    }
+    SparseGrid grid;
+    RebuildGrid(m, P, grid);
+    StepContext ctx;
+    ctx.dx = m.dx;
+    ctx.inv_dx = 1 / m.dx;
+    MarkWallContacts(m, ctx, P, grid);
+    WallPlane walls[kFaceCount];
+    const int count = ActiveWalls(m, walls);
+    ASSERT_EQ(count, 2 * dim);
+    int touching = 0;
+    for (size_t p = 0; p < P.size(); ++p)
+      for (int k = 0; k < count; ++k) {
+        const Real d = walls[k].sign * (P.x[p][walls[k].axis] - walls[k].level);
+        if (d > 0.75 * std::pow(P.volume0[p], 1.0 / dim)) continue;
+        ++touching;
+        Vec3i node;
+        for (int a = 0; a < 3; ++a) node[a] = int(std::lround(P.x[p][a] / m.dx));
+        EXPECT_TRUE(WallTouched(grid, k, node)) << "dim " << dim << " particle " << p << " wall " << k;
+      }
+    EXPECT_GE(touching, 4 * dim) << "dim " << dim;  // the deep ones touch every wall
   }
 }
 
