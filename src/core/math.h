@@ -15,6 +15,15 @@ using Vec3i = Eigen::Matrix<int, 3, 1>;
 
 inline Mat3 Identity3() { return Mat3::Identity(); }
 
+// The incremental deformation gradient f = I + dt L (Mast 2013 (2.18)), entry by entry: bitwise
+// Eigen's `Mat3::Identity() + dt * L`, which GCC called out of line in the hot loops.
+inline Mat3 Increment(Real dt, const Mat3& L) {
+  Mat3 f;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) f(i, j) = (i == j ? 1.0 : 0.0) + dt * L(i, j);
+  return f;
+}
+
 // Symmetric part of a 3x3 matrix.
 inline Mat3 Sym(const Mat3& a) { return 0.5 * (a + a.transpose()); }
 

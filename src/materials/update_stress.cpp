@@ -36,7 +36,7 @@ Real StressPowerOf(const SymMat3& stress, const Mat3& l, Real J, Real V0) {
 // (I + dt L) F_n, then the model's stress. Hencky models go through UpdateSpan's pairs instead.
 template <class Pm>
 void UpdateOne(const Pm& params, Real dt, size_t p, const Mat3& L, Particles& P) {
-  const Mat3 f = Mat3::Identity() + dt * L;  // (2.18)
+  const Mat3 f = Increment(dt, L);  // (2.18)
   P.F[p] = f * P.F[p];
   if constexpr (std::is_same_v<Pm, LinearElasticParams>) {
     Mat3 stress = P.stress[p];
@@ -91,7 +91,7 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
         p[i] = index(k0 + i);
         const Mat3& L = grad(k0 + i);
         if (energy) before[i] = power_of(p[i], L, P.F[p[i]].determinant());
-        f[i] = Mat3::Identity() + dt * L;  // (2.18)
+        f[i] = Increment(dt, L);  // (2.18)
         P.F[p[i]] = f[i] * P.F[p[i]];
         b[i] = P.elastic_b[p[i]];  // b^e stored as its 6 components
       }
