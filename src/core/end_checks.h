@@ -1,6 +1,7 @@
 // The per-particle tests of the step's last stages (DomainExitStage, CheckStateStage), shared
-// with the fused G2P stress update, which runs them on each particle right after its update
-// (GridToParticleStressCheckStage) so that those stages can skip their passes.
+// with the stress updates that run them on each particle right after its update
+// (GridToParticleStressCheckStage, UpdateStressAdvectCheckStage) so that those stages can skip
+// their passes. ObstacleProjectionStage tests again the particles it moves.
 #pragma once
 #include <cmath>
 
@@ -46,11 +47,16 @@ inline bool SurelyHealthy(const Particles& P, size_t p, Real J) {
 }
 
 // Both tests over the particles a fused stress update has finished; `clean` stays true while
-// every particle is inside the box and surely healthy.
+// every particle is inside the box and surely healthy. With `advect` (deferred advection, where
+// the stress update is the last stage before AdvectStage), Test first moves the particle,
+// x_{n+1} = x_n + dt v_{n+1} (Mast 2013 (2.16)), bitwise as AdvectParticles does.
 struct EndChecks {
   DomainBox box;
+  bool advect = false;
+  Real dt = 0;
   bool clean = true;
-  void Test(const Particles& P, size_t p, Real J) {
+  void Test(Particles& P, size_t p, Real J) {
+    if (advect) P.x[p] = P.x[p] + dt * P.v[p];  // (2.16)
     clean &= !box.Outside(P.x[p]) & SurelyHealthy(P, p, J);
   }
 };

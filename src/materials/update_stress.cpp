@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <type_traits>
 
 #include "core/parallel.h"
@@ -133,34 +134,43 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
 
 void UpdateStress(const Model& model, const StepContext& ctx,
                   const std::vector<Mat3>& velocity_gradient,
-                  const std::vector<MaterialGroup>& groups, Particles& P, Real* stress_power) {
+                  const std::vector<MaterialGroup>& groups, Particles& P, Real* stress_power,
+                  const EndChecks* checks, bool* clean) {
   const Real dt = ctx.dt;
   const bool energy = stress_power != nullptr;
   if (energy) *stress_power = 0;
+  // Set by any span with a particle that fails the checks: a set, so thread-independent.
+  std::atomic<bool> dirty{false};
   for (const MaterialGroup& g : groups) {
     const size_t count = g.end - g.begin;
     std::visit(
         [&](const auto& params) {
           const auto index = [&](size_t k) { return g.begin + k; };
           const auto grad = [&](size_t k) -> const Mat3& { return velocity_gradient[g.begin + k]; };
+          // One span's update, with its own copy of the checks.
+          const auto span = [&](size_t b, size_t e, bool with_energy) {
+            if (!checks) return UpdateSpan(params, dt, b, e, index, grad, P, with_energy);
+            EndChecks own = *checks;
+            const Real sum = UpdateSpan(params, dt, b, e, index, grad, P, with_energy, &own);
+            if (!own.clean) dirty.store(true, std::memory_order_relaxed);
+            return sum;
+          };
           if (!energy) {
             // Spans of 256 (Hencky models, in pairs) or 1024 particles.
             const size_t grain = kIsElastoplastic<std::decay_t<decltype(params)>> ? 256 : 1024;
             ParallelForStatic((count + grain - 1) / grain, [&](size_t c) {
-              UpdateSpan(params, dt, c * grain, std::min(count, (c + 1) * grain), index, grad, P,
-                         false);
+              span(c * grain, std::min(count, (c + 1) * grain), false);
             });
             return;
           }
           // With the stress power: fixed chunks, summed in chunk order (any thread count).
           std::array<Real, kReductionChunks> partial{};
-          ParallelChunks(count, [&](size_t c, size_t b, size_t e) {
-            partial[c] = UpdateSpan(params, dt, b, e, index, grad, P, true);
-          });
+          ParallelChunks(count, [&](size_t c, size_t b, size_t e) { partial[c] = span(b, e, true); });
           for (Real v : partial) *stress_power += v;
         },
         model.materials[g.material].params);
   }
+  if (clean) *clean = checks && !dirty.load();
 }
 
 Real UpdateStressOfRun(const Model& model, const StepContext& ctx, const uint32_t* ids,

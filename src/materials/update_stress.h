@@ -14,11 +14,14 @@ namespace surge {
 // what the group's model keeps (linear_elastic: strain; plastic models: elastic_b, history; yield-
 // stress fluids: history), writes F, stress and that state. With `stress_power` non-null it is
 // set to P_n + P_{n+1}, P = sum_p J_p V0_p sigma_p : sym(L_p) [W] before and after the update
-// (the energy record's internal work, docs/stability.md), summed in fixed chunks.
+// (the energy record's internal work, docs/stability.md), summed in fixed chunks. With `checks`,
+// each particle goes through a copy of them right after its update, and `clean` is set to whether
+// every particle passed (core/end_checks.h).
 void UpdateStress(const Model& model, const StepContext& ctx,
                   const std::vector<Mat3>& velocity_gradient,
                   const std::vector<MaterialGroup>& groups, Particles& particles,
-                  Real* stress_power = nullptr);
+                  Real* stress_power = nullptr, const EndChecks* checks = nullptr,
+                  bool* clean = nullptr);
 
 // The same update for the particles ids[0..n) with gradients velocity_gradient[0..n) (one run of
 // G2P: the step fuses the stress update into G2P where nothing else reads L, docs/architecture.md).

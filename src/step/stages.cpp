@@ -109,6 +109,14 @@ void SensorsStage(const Model& m, const StepContext& c, State&, Workspace& w, St
 void ObstacleProjectionStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                              StepReport& r) {
   ProjectParticlesOutOfObstacles(m, c, s.rigid, w.grid, s.particles, w.contact, &r.obstacles);
+  // The end checks passed before the projection (a stress stage ran them): the particles it moved
+  // and slowed take them again.
+  if (!w.end_checks_passed) return;
+  EndChecks checks{DomainBox::Of(m)};
+  for (const auto& list : w.contact.moved)
+    for (const ProjectedParticle& moved : list)
+      checks.Test(s.particles, moved.particle, s.particles.F[moved.particle].determinant());
+  w.end_checks_passed = checks.clean;
 }
 
 void GridToParticleUslStage(const Model& m, const StepContext& c, State& s, Workspace& w,
@@ -228,6 +236,19 @@ void UpdateStressStage(const Model& m, const StepContext& c, State& s, Workspace
   Real power = 0;
   UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles, m.output.energy ? &power : nullptr);
   if (m.output.energy) s.internal_work += 0.5 * c.dt * power;
+}
+
+void UpdateStressAdvectCheckStage(const Model& m, const StepContext& c, State& s, Workspace& w,
+                                  StepReport&) {
+  Real power = 0;  // as UpdateStressStage
+  EndChecks checks{DomainBox::Of(m)};
+  checks.advect = true;
+  checks.dt = c.dt;
+  bool clean = false;
+  UpdateStress(m, c, w.velocity_gradient, s.groups, s.particles, m.output.energy ? &power : nullptr,
+               &checks, &clean);
+  if (m.output.energy) s.internal_work += 0.5 * c.dt * power;
+  w.end_checks_passed = clean;
 }
 
 void BulkViscosityRateStage(const Model& m, const StepContext& c, State& s, Workspace& w,

@@ -35,8 +35,9 @@ void GridToParticleUslStage(const Model&, const StepContext&, State&, Workspace&
 void GridToParticleStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 // The same, and the run's particles then pass through the domain-exit test and the fast test of
 // the health check while they are in cache: where nothing after G2P moves a particle or changes its
-// v, F or stress before DomainExitStage (no particle shifting, no obstacles), a step whose
-// particles all pass skips both stages' passes over the particles (docs/benchmarks.md).
+// v, F or stress before DomainExitStage (no particle shifting, no deferred advection, no stress
+// averaging; an obstacle's projection tests again the particles it moves), a step whose particles
+// all pass skips both stages' passes over the particles (docs/benchmarks.md).
 void GridToParticleStressCheckStage(const Model&, const StepContext&, State&, Workspace&,
                                     StepReport&);
 void GridToParticleMuslStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
@@ -55,6 +56,13 @@ void AdvectStage(const Model&, const StepContext&, State&, Workspace&, StepRepor
 void AntiLockingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void StressAveragingStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
 void UpdateStressStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);
+// With deferred advection and nothing between the stress update and AdvectStage (no stress
+// averaging) nor after it that moves every particle (no particle shifting): UpdateStressStage,
+// then each particle is advected and passes the end checks right after its update, in place of
+// AdvectStage and, when all pass, of DomainExitStage's and CheckStateStage's passes. Bitwise the
+// same state; the advection's time is in the update_stress clock.
+void UpdateStressAdvectCheckStage(const Model&, const StepContext&, State&, Workspace&,
+                                  StepReport&);
 // Artificial bulk viscosity (src/stabilize/bulk_viscosity.h): q_p from this step's L_p (after
 // UpdateStress), sigma - q 1 for ParticleToGrid (before it) and the material stress back (after).
 void BulkViscosityRateStage(const Model&, const StepContext&, State&, Workspace&, StepReport&);

@@ -92,8 +92,9 @@ Pipeline MakePipeline(const Model& model) {
   if (shifting) p.push_back({Stage::kParticleShifting, ParticleShiftComputeStage});
   const bool defer = DeferredAdvection(model);
   // The stages between G2P and the domain exit that could move a particle or change v, F or the
-  // stress: with none, G2P also runs the domain-exit and health tests (stages.h).
-  const bool end_checks = !shifting && !obstacles && !defer && !AnyStressAveraging(model);
+  // stress: with none, G2P also runs the domain-exit and health tests (stages.h). The obstacle
+  // projection tests again the particles it moves.
+  const bool end_checks = !shifting && !defer && !AnyStressAveraging(model);
   if (fused) {
     p.push_back({Stage::kGridToParticle, end_checks ? GridToParticleStressCheckStage
                                                     : GridToParticleStressStage});  // (2.17)-(2.22)
@@ -112,10 +113,15 @@ Pipeline MakePipeline(const Model& model) {
   // the positions they move nor the grid reactions; with deferred advection the anti-locking's
   // shape functions still see x_n.
   if (antilocking) p.push_back({Stage::kAntiLocking, AntiLockingStage});       // (4.25)-(4.32)
-  if (!fused) p.push_back({Stage::kUpdateStress, UpdateStressStage});          // (2.18)-(2.20)
+  // Deferred advection right after the stress update, nothing moving every particle after it:
+  // the update advects and checks each particle (stages.h).
+  const bool advect_checks = !fused && defer && !shifting && !AnyStressAveraging(model);
+  if (!fused)
+    p.push_back({Stage::kUpdateStress, advect_checks ? UpdateStressAdvectCheckStage    // (2.16),
+                                                     : UpdateStressStage});            // (2.18)-(2.20)
   if (AnyStressAveraging(model))  // Table 4.1 steps 6-7, timed with the strain projection
     p.push_back({Stage::kAntiLocking, StressAveragingStage});
-  if (defer) p.push_back({Stage::kGridToParticle, AdvectStage});               // (2.16)
+  if (defer && !advect_checks) p.push_back({Stage::kGridToParticle, AdvectStage});  // (2.16)
   if (shifting) p.push_back({Stage::kParticleShifting, ParticleShiftApplyStage});  // x_{n+1}
   if (obstacles) p.push_back({Stage::kObstacleProjection, ObstacleProjectionStage});
   const bool dynamic = std::any_of(model.obstacles.begin(), model.obstacles.end(), [](const Obstacle& o) {
