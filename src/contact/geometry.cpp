@@ -41,6 +41,19 @@ void ActiveFaces(const std::array<Real, N>& q_all, const std::array<Vec3, N>& n,
   }
 }
 
+// A point inside (distance <= 0) lies under its nearest exposed face: the signed distance is that
+// face's q, not a buried face's, so that the particle projection (ProjectParticlesOutOfObstacles)
+// moves it by the distance to the face whose normal it moves along. Outside, `distance` is kept.
+template <size_t N>
+Real ExposedInsideDistance(Real distance, const std::array<Real, N>& q, const std::array<int, N>& face,
+                           uint64_t buried) {
+  if (distance > 0 || buried == 0) return distance;
+  Real nearest = -kInf;
+  for (size_t k = 0; k < N; ++k)
+    if (!Buried(buried, face[k])) nearest = std::max(nearest, q[k]);
+  return nearest > -kInf ? nearest : distance;  // every face buried: nothing to move to
+}
+
 // Distance from "inside all face constraints" q (each q_k <= 0 inside) combined like a box:
 // outside = length of the positive parts, inside = the largest (negative) part.
 template <size_t N>
@@ -75,9 +88,18 @@ SurfaceQuery QueryBox(const BoxShape& s, const Vec3& p, int dim, Real tol, uint6
     n[a] = Vec3::Zero();
     n[a][a] = upper ? 1 : -1;
     face[a] = 2 * a + (upper ? 1 : 0);  // x-, x+, y-, y+, z-, z+
+    // Inside along a, the nearer face buried (on or beyond the domain boundary) and the farther
+    // one not: the farther one is this axis' candidate (a barrier's foot on the floor, a post
+    // reaching past an open side).
+    const int far = 2 * a + (upper ? 0 : 1);
+    if (a < dim && q[a] <= 0 && Buried(buried, face[a]) && !Buried(buried, far)) {
+      q[a] = -std::abs(p[a] - c[a]) - h[a];
+      n[a][a] = -n[a][a];
+      face[a] = far;
+    }
   }
   SurfaceQuery out;
-  out.distance = CombineBox(q);
+  out.distance = ExposedInsideDistance(CombineBox(q), q, face, buried);
   if (out.distance <= tol) ActiveFaces(q, n, face, tol, buried, out);
   return out;
 }
@@ -112,7 +134,7 @@ SurfaceQuery QueryCylinder(const CylinderShape& s, const Vec3& p, Real tol, uint
   SurfaceQuery out;
   // Capped cylinder: combine the radial and the axial distance like a 2-D box.
   const std::array<Real, 2> q2 = {q[0], std::max(q[1], q[2])};
-  out.distance = CombineBox(q2);
+  out.distance = ExposedInsideDistance(CombineBox(q2), q, face, buried);
   if (out.distance <= tol) ActiveFaces(q, n, face, tol, buried, out);
   return out;
 }
