@@ -592,10 +592,10 @@ int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ct
         if (!in_box) continue;
         const Obstacle& ob = model.obstacles[o];
         const SurfaceQuery q = QueryObstacle(ob, poses[o], x, model.dim, 0, ctx.dx);
-        if (!(q.distance < 0) || q.count == 0) continue;
-        // Back onto the nearest exposed face, a hair (1e-9 h) outside so that round-off on
-        // rotated or curved faces cannot leave it inside.
-        x -= (q.distance - 1e-9 * ctx.dx) * q.normal[0];
+        if (!(q.distance < 0) || q.exit_face < 0) continue;
+        // Back onto the nearest exposed face (SurfaceQuery::exit_face), a hair (1e-9 h) outside
+        // so that round-off on rotated or curved faces cannot leave it inside.
+        x -= (q.exit_distance - 1e-9 * ctx.dx) * q.exit_normal;
         // In a wedge between the obstacle and a walled side of the domain (a plate leaning
         // against the lid), the push can carry the particle past the wall, which DomainExit
         // would then clamp back into the obstacle. Alternate the two projections (onto the
@@ -612,16 +612,18 @@ int64_t ProjectParticlesOutOfObstacles(const Model& model, const StepContext& ct
           }
           if (!clamped) break;
           const SurfaceQuery again = QueryObstacle(ob, poses[o], x, model.dim, 0, ctx.dx);
-          if (!(again.distance < 0) || again.count == 0) break;
-          x -= (again.distance - 1e-9 * ctx.dx) * again.normal[0];
+          if (!(again.distance < 0) || again.exit_face < 0) break;
+          x -= (again.exit_distance - 1e-9 * ctx.dx) * again.exit_normal;
         }
         SurfaceQuery one = q;
         one.count = 1;
+        one.normal[0] = q.exit_normal;
+        one.face[0] = q.exit_face;
         Vec3 dv[kMaxContactFaces];
         const Vec3 before = P.v[p];
         Constrain(one, ob.contact, poses[o].PointVelocity(x), 0, P.v[p], dv);
         const Vec3 f = P.mass[p] * (before - P.v[p]) / ctx.dt;
-        scratch.moved[chunk].push_back({p, uint32_t(o), q.face[0], f, (x - ref[o]).cross(f)});
+        scratch.moved[chunk].push_back({p, uint32_t(o), q.exit_face, f, (x - ref[o]).cross(f)});
       }
     }
   });

@@ -41,17 +41,19 @@ void ActiveFaces(const std::array<Real, N>& q_all, const std::array<Vec3, N>& n,
   }
 }
 
-// A point inside (distance <= 0) lies under its nearest exposed face: the signed distance is that
-// face's q, not a buried face's, so that the particle projection (ProjectParticlesOutOfObstacles)
-// moves it by the distance to the face whose normal it moves along. Outside, `distance` is kept.
+// The exit face of a point inside (SurfaceQuery::exit_*): among faces k with signed distances
+// q[k] (<= 0 inside) and outward normals n[k], the nearest one that is not buried.
 template <size_t N>
-Real ExposedInsideDistance(Real distance, const std::array<Real, N>& q, const std::array<int, N>& face,
-                           uint64_t buried) {
-  if (distance > 0 || buried == 0) return distance;
-  Real nearest = -kInf;
-  for (size_t k = 0; k < N; ++k)
-    if (!Buried(buried, face[k])) nearest = std::max(nearest, q[k]);
-  return nearest > -kInf ? nearest : distance;  // every face buried: nothing to move to
+void NearestExposedFace(const std::array<Real, N>& q, const std::array<Vec3, N>& n,
+                        const std::array<int, N>& face, uint64_t buried, SurfaceQuery& out) {
+  Real best = -kInf;
+  for (size_t k = 0; k < N; ++k) {
+    if (Buried(buried, face[k]) || !(q[k] > best)) continue;
+    best = q[k];
+    out.exit_distance = q[k];
+    out.exit_normal = n[k];
+    out.exit_face = face[k];
+  }
 }
 
 // Distance from "inside all face constraints" q (each q_k <= 0 inside) combined like a box:
@@ -88,19 +90,26 @@ SurfaceQuery QueryBox(const BoxShape& s, const Vec3& p, int dim, Real tol, uint6
     n[a] = Vec3::Zero();
     n[a][a] = upper ? 1 : -1;
     face[a] = 2 * a + (upper ? 1 : 0);  // x-, x+, y-, y+, z-, z+
-    // Inside along a, the nearer face buried (on or beyond the domain boundary) and the farther
-    // one not: the farther one is this axis' candidate (a barrier's foot on the floor, a post
-    // reaching past an open side).
-    const int far = 2 * a + (upper ? 0 : 1);
-    if (a < dim && q[a] <= 0 && Buried(buried, face[a]) && !Buried(buried, far)) {
-      q[a] = -std::abs(p[a] - c[a]) - h[a];
-      n[a][a] = -n[a][a];
-      face[a] = far;
-    }
   }
   SurfaceQuery out;
-  out.distance = ExposedInsideDistance(CombineBox(q), q, face, buried);
+  out.distance = CombineBox(q);
   if (out.distance <= tol) ActiveFaces(q, n, face, tol, buried, out);
+  if (buried != 0 && out.distance <= 0) {
+    // Inside, with buried faces: every face of the box is a candidate exit, the far face of an
+    // axis too (a barrier's foot on the floor: the top or a side; a post reaching past a side).
+    std::array<Real, 6> qe;
+    std::array<Vec3, 6> ne;
+    std::array<int, 6> fe;
+    for (int a = 0; a < 3; ++a) {
+      qe[2 * a] = a < dim ? s.min[a] - p[a] : -kInf;  // a-: outward normal -e_a
+      qe[2 * a + 1] = a < dim ? p[a] - s.max[a] : -kInf;
+      ne[2 * a] = -Vec3::Unit(a);
+      ne[2 * a + 1] = Vec3::Unit(a);
+      fe[2 * a] = 2 * a;
+      fe[2 * a + 1] = 2 * a + 1;
+    }
+    NearestExposedFace(qe, ne, fe, buried, out);
+  }
   return out;
 }
 
@@ -134,8 +143,9 @@ SurfaceQuery QueryCylinder(const CylinderShape& s, const Vec3& p, Real tol, uint
   SurfaceQuery out;
   // Capped cylinder: combine the radial and the axial distance like a 2-D box.
   const std::array<Real, 2> q2 = {q[0], std::max(q[1], q[2])};
-  out.distance = ExposedInsideDistance(CombineBox(q2), q, face, buried);
+  out.distance = CombineBox(q2);
   if (out.distance <= tol) ActiveFaces(q, n, face, tol, buried, out);
+  if (buried != 0 && out.distance <= 0) NearestExposedFace(q, n, face, buried, out);  // on the floor
   return out;
 }
 
@@ -290,6 +300,13 @@ SurfaceQuery QueryObstacle(const Obstacle& obstacle, const ObstaclePose& pose, c
       },
       obstacle.shape);
   for (int k = 0; k < q.count; ++k) q.normal[k] = pose.rotation * q.normal[k];
+  if (q.exit_face >= 0) {
+    q.exit_normal = pose.rotation * q.exit_normal;
+  } else if (q.count > 0) {  // the exit is the nearest active face
+    q.exit_distance = q.distance;
+    q.exit_normal = q.normal[0];
+    q.exit_face = q.face[0];
+  }
   return q;
 }
 

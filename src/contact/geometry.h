@@ -39,6 +39,15 @@ struct SurfaceQuery {
   int count = 0;      // active faces (filled only when distance <= tolerance)
   std::array<Vec3, kMaxContactFaces> normal{};  // outward unit normals, world frame
   std::array<int, kMaxContactFaces> face{};     // indices into Obstacle::faces
+  // The face a point inside leaves through (ProjectParticlesOutOfObstacles): the nearest exposed
+  // face, its signed distance (< 0 inside) and outward normal (world frame); -1 when there is
+  // none. It differs from `distance` and face[0] only for boxes and cylinders with buried faces
+  // (Obstacle::buried_faces): there `distance` may be a buried face's, which the grid contact
+  // keeps (a slab box between two walls: every node within a cell of a wall), but a particle
+  // moved by it along an exposed face's normal would stay inside.
+  Real exit_distance = 0;
+  Vec3 exit_normal = Vec3::Zero();
+  int exit_face = -1;
 };
 
 // Signed distance of world point x to the obstacle at `pose`, and, when distance <= tolerance,

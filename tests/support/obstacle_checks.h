@@ -15,7 +15,9 @@ inline Real MaxPenetration(const LoadedScene& scene) {
   for (const Obstacle& o : scene.model.obstacles) {
     const ObstaclePose pose = PoseAt(o, scene.state.time, &scene.state.rigid);
     for (const Vec3& x : scene.state.particles.x) {
-      const Real d = QueryObstacle(o, pose, x, scene.model.dim, 0, scene.model.dx).distance;
+      const SurfaceQuery q = QueryObstacle(o, pose, x, scene.model.dim, 0, scene.model.dx);
+      // Inside: the depth below the face it would leave through (SurfaceQuery::exit_face).
+      const Real d = q.distance < 0 && q.exit_face >= 0 ? q.exit_distance : q.distance;
       depth = std::max(depth, -d);
     }
   }

@@ -665,33 +665,32 @@ TEST(ObstacleMeshFacesTest, FacesByNormalGroupTrianglesByDirection) {
 }
 
 // Buried faces (on or beyond the domain boundary, Obstacle::buried_faces) never act; a point
-// inside lies under its nearest exposed face, at that face's distance, which is what the particle
-// projection moves it by (ProjectParticlesOutOfObstacles).
-TEST(ObstacleBuriedFacesTest, InsidePointLiesUnderItsNearestExposedFace) {
+// inside leaves through its nearest exposed face (SurfaceQuery::exit_*), by that face's distance:
+// the particle projection moves it so (ProjectParticlesOutOfObstacles).
+TEST(ObstacleBuriedFacesTest, InsidePointLeavesThroughItsNearestExposedFace) {
   // The domain is [-1, 2]^2. A block on the floor, y- buried: 0.05 above the floor, the nearest
-  // exposed face is x- at 0.7 (it was the floor's 0.05 along -x, leaving the particle inside).
+  // exposed face is x- at 0.7 (the projection had moved it by the floor's 0.05 along -x, leaving
+  // it inside).
   {
     const LoadedScene s = LoadSceneFromString(
         WithObstacle(2, "{name: foot, shape: {box: {min: [0.2, -1], max: [1.8, 0.2]}}}\n"), "s.yaml");
     const Obstacle& o = OnlyObstacle(s);
     const SurfaceQuery q = QueryObstacle(o, PoseAt(o, 0), Vec3(0.9, -0.95, 0), 2, 0, 0.25);
-    EXPECT_EQ(q.count, 1);
-    EXPECT_EQ(o.faces[size_t(q.face[0])], "x-");
-    EXPECT_NEAR(q.distance, -0.7, 1e-12);
-    EXPECT_EQ(q.normal[0], Vec3(-1, 0, 0));
+    EXPECT_EQ(q.exit_face, 0);  // x-
+    EXPECT_NEAR(q.exit_distance, -0.7, 1e-12);
+    EXPECT_EQ(q.exit_normal, Vec3(-1, 0, 0));
   }
   // A slab across the whole domain: x-, x+ and y- buried, the top the only exposed face. Below
   // the middle the nearer y face is the buried floor; the top, 1.1 up, is the one to move to
-  // (there was no face at all).
+  // (the projection had found no face and left the particle inside).
   {
     const LoadedScene s = LoadSceneFromString(
         WithObstacle(2, "{name: slab, shape: {box: {min: [-2, -1], max: [3, 0.2]}}}\n"), "s.yaml");
     const Obstacle& o = OnlyObstacle(s);
     const SurfaceQuery q = QueryObstacle(o, PoseAt(o, 0), Vec3(0.5, -0.9, 0), 2, 0, 0.25);
-    EXPECT_EQ(q.count, 1);
-    EXPECT_EQ(q.face[0], 3);  // y+
-    EXPECT_NEAR(q.distance, -1.1, 1e-12);
-    EXPECT_EQ(q.normal[0], Vec3(0, 1, 0));
+    EXPECT_EQ(q.exit_face, 3);  // y+
+    EXPECT_NEAR(q.exit_distance, -1.1, 1e-12);
+    EXPECT_EQ(q.exit_normal, Vec3(0, 1, 0));
   }
   // A 3-D post standing on the floor (a cylinder, base buried): 0.02 above the floor the side,
   // 0.1 away, is the nearest exposed face.
@@ -702,9 +701,8 @@ TEST(ObstacleBuriedFacesTest, InsidePointLiesUnderItsNearestExposedFace) {
         "s.yaml");
     const Obstacle& o = OnlyObstacle(s);
     const SurfaceQuery q = QueryObstacle(o, PoseAt(o, 0), Vec3(1.7, -0.98, 1.5), 3, 0, 0.25);
-    EXPECT_EQ(q.count, 1);
-    EXPECT_EQ(q.face[0], 0);  // the side
-    EXPECT_NEAR(q.distance, -0.1, 1e-12);
+    EXPECT_EQ(q.exit_face, 0);  // the side
+    EXPECT_NEAR(q.exit_distance, -0.1, 1e-12);
   }
 }
 

@@ -39,17 +39,21 @@ LoadedScene MovingBlock(const std::string& walls, const std::string& on_exit, do
   return LoadSceneFromString(MovingBlockText(walls, on_exit, o), "exit_test.yaml");
 }
 
-// The moving block (open sides, particles removed; at `speed` m/s) and a post from x = lo to hi,
-// 0.3 <= y <= 0.7, with or without the contact's gap test.
-LoadedScene BlockAndPost(double lo, double hi, double speed = 3, bool gap_test = true) {
+// The moving block (open sides, particles removed; at `speed` m/s) and an obstacle of `shape`.
+LoadedScene BlockAnd(const std::string& shape, double speed = 3, bool gap_test = true) {
   std::string text = MovingBlockText("{}", "remove");
   text.replace(text.find("velocity: [3, 0]"), 16, "velocity: [" + std::to_string(speed) + ", 0]");
+  text += "obstacles:\n  - {name: post, shape: " + shape + ", contact: {" +
+          (gap_test ? "" : "faces: nodes, gap_test: false") + "}}\n";
+  return LoadSceneFromString(text, "exit_test.yaml");
+}
+
+// A post from x = lo to hi, 0.3 <= y <= 0.7.
+std::string Post(double lo, double hi) {
   std::ostringstream s;
   s.precision(17);
-  s << text << "obstacles:\n  - {name: post, shape: {box: {min: [" << lo
-    << ", 0.3], max: [" << hi << ", 0.7]}}, contact: {"
-    << (gap_test ? "" : "faces: nodes, gap_test: false") << "}}\n";
-  return LoadSceneFromString(s.str(), "exit_test.yaml");
+  s << "{box: {min: [" << lo << ", 0.3], max: [" << hi << ", 0.7]}}";
+  return s.str();
 }
 
 HealthStatus RunFor(LoadedScene& scene, Real end) {
@@ -118,7 +122,7 @@ TEST(DomainTest, FusedEndChecksOnlyWhereNothingMovesEveryParticleAfterGridToPart
   LoadedScene shifting = LoadSceneFromString(text, "exit_test.yaml");
   EXPECT_FALSE(UsesFusedEndChecks(MakePipeline(shifting.model)));
   // An obstacle's projection does not: it tests again the particles it moves.
-  LoadedScene post = BlockAndPost(0.1, 0.2);
+  LoadedScene post = BlockAnd(Post(0.1, 0.2));
   EXPECT_TRUE(UsesFusedEndChecks(MakePipeline(post.model)));
 }
 
@@ -143,11 +147,11 @@ Pipeline Replace(Pipeline pipeline, StageFn from, StageFn to) {
 }
 
 TEST(DomainTest, ParticleProjectedOutThroughAnOpenSideIsStillRemoved) {
-  // G2P's end checks pass; then a particle is put inside the post's part beyond the open x+ side
-  // (x = 1.015 of the post's [0.95, 1.02]). The projection moves it (the face x = 1.02 is buried,
-  // beyond the domain, so it does not push it out there) and it stays beyond the side: the stage
-  // tests the particles it moves again, so DomainExitStage runs its pass and removes it.
-  LoadedScene scene = BlockAndPost(0.95, 1.02);
+  // G2P's end checks pass; then a particle is put inside the part of a disk beyond the open x+
+  // side (centre x = 1.05, radius 0.1; the particle at x = 1.1), and the projection moves it out
+  // along the radius to x = 1.15, still beyond the side. The stage tests the particles it moves
+  // again, so DomainExitStage runs its pass and removes it.
+  LoadedScene scene = BlockAnd("{sphere: {center: [1.05, 0.5], radius: 0.1}}");
   Pipeline pipeline = MakePipeline(scene.model);
   ASSERT_TRUE(UsesFusedEndChecks(pipeline));
   Pipeline with_teleport;
@@ -160,7 +164,7 @@ TEST(DomainTest, ParticleProjectedOutThroughAnOpenSideIsStillRemoved) {
   teleport_particle = size_t(std::max_element(P.x.begin(), P.x.end(), [](const Vec3& a, const Vec3& b) {
                                return a.x() < b.x();
                              }) - P.x.begin());
-  teleport_to = Vec3(1.015, 0.5, 0);
+  teleport_to = Vec3(1.1, 0.5, 0);
   const size_t n0 = P.size();
   Workspace work;
   StepReport report;
@@ -176,8 +180,8 @@ TEST(DomainTest, FusedEndChecksWithAnObstacleGiveTheSameState) {
   // lie inside it, so particles enter it and are projected out. The fused pipeline (checks in
   // G2P, again after the projection) and the one with the checks in their own stages end bitwise
   // equal.
-  LoadedScene fused = BlockAndPost(0.95, 1.2, 20, false);
-  LoadedScene plain = BlockAndPost(0.95, 1.2, 20, false);
+  LoadedScene fused = BlockAnd(Post(0.95, 1.2), 20, false);
+  LoadedScene plain = BlockAnd(Post(0.95, 1.2), 20, false);
   const Pipeline a = MakePipeline(fused.model);
   ASSERT_TRUE(UsesFusedEndChecks(a));
   const Pipeline b = Replace(a, GridToParticleStressCheckStage, GridToParticleStressStage);
