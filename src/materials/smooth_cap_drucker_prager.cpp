@@ -22,14 +22,19 @@ Cap CapOf(const SmoothCapDruckerPragerParams& p) {
           p.yield_stress / d};  // spec §2.6 [REC] reconstruction (erratum 6)
 }
 
+// The yield function of the surface that applies at I1, from the invariants I1 = tr(tau) and
+// s = ||dev tau|| and the cap's constants.
+Real YieldOf(const SmoothCapDruckerPragerParams& p, const Cap& cap, Real I1, Real s) {
+  if (I1 <= cap.I1_tangent) return s + p.friction_slope * I1 - p.yield_stress;  // F1 (3.101)
+  return std::sqrt(s * s + I1 * I1 / 3.0) - cap.radius;                         // F2
+}
+
 }  // namespace
 
 Real SmoothCapYield(const SmoothCapDruckerPragerParams& p, const Vec3& tau) {
-  const Cap cap = CapOf(p);
   const Real I1 = tau.sum();
-  const Real s = (tau.array() - I1 / 3.0).matrix().norm();
-  if (I1 <= cap.I1_tangent) return s + p.friction_slope * I1 - p.yield_stress;  // F1 (3.101)
-  return std::sqrt(s * s + I1 * I1 / 3.0) - cap.radius;                         // F2
+  const Vec3 s = (tau.array() - I1 / 3.0).matrix();
+  return YieldOf(p, CapOf(p), I1, s.norm());
 }
 
 int SmoothCapReturn(const SmoothCapDruckerPragerParams& p, const Vec3& tau_trial, Vec3& tau) {
@@ -39,7 +44,7 @@ int SmoothCapReturn(const SmoothCapDruckerPragerParams& p, const Vec3& tau_trial
   const Vec3 s = (tau_trial.array() - I1 / 3.0).matrix();
   const Real s_norm = s.norm();
   tau = tau_trial;
-  if (SmoothCapYield(p, tau_trial) <= 0) return 0;
+  if (YieldOf(p, cap, I1, s_norm) <= 0) return 0;  // the cap and invariants computed once
 
   const Real rho_f = p.friction_slope, rho_g = p.associativity * p.friction_slope;
   // Cone return (3.88)-(3.91) with H = k = 0, accepted if it lands on the cone part (I1 <= I_t)

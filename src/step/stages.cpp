@@ -133,15 +133,24 @@ void FusedGridToParticleStress(const Model& m, const StepContext& c, State& s, W
   const size_t runs = w.grid.runs.size();
   w.run_power.assign(energy ? runs : 0, 0.0);
   w.run_clean.assign(end_checks ? runs : 0, 0);
-  const DomainBox box = DomainBox::Of(m);
-  const GradientSink sink = [&](size_t run, const uint32_t* ids, const Mat3* L, size_t n) {
+  // The sink captures one reference, so that std::function keeps it without a heap allocation.
+  const struct {
+    const Model& m;
+    const StepContext& c;
+    State& s;
+    Workspace& w;
+    bool energy, end_checks;
+    DomainBox box;
+  } run_args{m, c, s, w, energy, end_checks, DomainBox::Of(m)};
+  const GradientSink sink = [&a = run_args](size_t run, const uint32_t* ids, const Mat3* L,
+                                            size_t n) {
     // The tests run on each particle right after its update, while it is in cache: its state is
     // final for this step (see GridToParticleStressCheckStage).
-    EndChecks checks{box};
-    const Real power = UpdateStressOfRun(m, c, ids, L, n, s.particles, energy,  // (2.18)-(2.20)
-                                         end_checks ? &checks : nullptr);
-    if (energy) w.run_power[run] = power;
-    if (end_checks) w.run_clean[run] = checks.clean;
+    EndChecks checks{a.box};
+    const Real power = UpdateStressOfRun(a.m, a.c, ids, L, n, a.s.particles, a.energy,  // (2.18)-(2.20)
+                                         a.end_checks ? &checks : nullptr);
+    if (a.energy) a.w.run_power[run] = power;
+    if (a.end_checks) a.w.run_clean[run] = checks.clean;
   };
   GridToParticle(m, c, w.grid, s.particles, nullptr, nullptr, &sink);
   if (energy) {

@@ -134,9 +134,22 @@ void OrderedBlockScatter(const SparseGrid& grid, int dim, const Accumulate& accu
       }
     return;
   }
-  std::vector<std::array<int32_t, 8>> writer(nb);  // [X][colour]: the block writing X, or -1
-  std::vector<uint8_t> writers(nb, 0), written(nb, 0), state(nb, 0);  // state 1: claimed
-  for (auto& w : writer) w.fill(-1);
+  // Scratch kept between calls (no allocation per step once grown): [X][colour], the block
+  // writing X or -1; the colours writing X; the colours added into X; state 1: claimed.
+  // Named through plain references: a thread_local named inside the lambdas below would be the
+  // worker thread's own (empty) copy.
+  thread_local std::vector<std::array<int32_t, 8>> writer_scratch;
+  thread_local std::vector<uint8_t> writers_scratch, written_scratch, state_scratch;
+  auto& writer = writer_scratch;
+  auto& writers = writers_scratch;
+  auto& written = written_scratch;
+  auto& state = state_scratch;
+  std::array<int32_t, 8> none;
+  none.fill(-1);
+  writer.assign(nb, none);
+  writers.assign(nb, 0);
+  written.assign(nb, 0);
+  state.assign(nb, 0);
   for (size_t b = 0; b < nb; ++b) {
     if (!has_particles(b)) continue;
     const int c = BlockColour(grid, b);

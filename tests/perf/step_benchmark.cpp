@@ -12,11 +12,44 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <new>
 #include <string>
 #include <thread>
 
 #include "scene/scene.h"
 #include "step/step.h"
+
+// Every operator new of the process is counted (calls and bytes), so that TimeSteps can report
+// the heap allocations a step makes after warm-up (issue #7: none expected).
+namespace {
+std::atomic<int64_t> g_new_calls{0}, g_new_bytes{0};
+
+void* CountedNew(std::size_t size, std::size_t align) {
+  g_new_calls.fetch_add(1, std::memory_order_relaxed);
+  g_new_bytes.fetch_add(int64_t(size), std::memory_order_relaxed);
+  void* p = align > alignof(std::max_align_t)
+                ? std::aligned_alloc(align, (size + align - 1) / align * align)
+                : std::malloc(size ? size : 1);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return CountedNew(size, 0); }
+void* operator new[](std::size_t size) { return CountedNew(size, 0); }
+void* operator new(std::size_t size, std::align_val_t a) { return CountedNew(size, std::size_t(a)); }
+void* operator new[](std::size_t size, std::align_val_t a) {
+  return CountedNew(size, std::size_t(a));
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 namespace surge {
 namespace {
@@ -78,7 +111,7 @@ output: {every: 0, energy: false}
 }
 
 // Takes `warmup` untimed steps, then times whole Step() calls; counters: particles,
-// particle-updates per second and milliseconds per stage.
+// particle-updates per second, milliseconds per stage and heap allocations per step.
 void TimeSteps(benchmark::State& bm, LoadedScene& scene, Workspace& work, int warmup) {
   const Pipeline pipeline = MakePipeline(scene.model);
   StepReport report;
@@ -86,10 +119,14 @@ void TimeSteps(benchmark::State& bm, LoadedScene& scene, Workspace& work, int wa
   report.stage_seconds.fill(0);
   const size_t n = scene.state.particles.size();
   int64_t steps = 0;
+  const int64_t calls0 = g_new_calls.load(), bytes0 = g_new_bytes.load();
   for (auto _ : bm) {
     Step(scene.model, pipeline, scene.state, work, report);
     ++steps;
   }
+  // Heap allocations per timed step (operator new, every thread), after the warm-up steps.
+  bm.counters["allocs_per_step"] = double(g_new_calls.load() - calls0) / double(steps);
+  bm.counters["alloc_bytes_per_step"] = double(g_new_bytes.load() - bytes0) / double(steps);
   bm.counters["particles"] = double(n);
   bm.counters["updates_per_s"] =
       benchmark::Counter(double(n) * double(steps), benchmark::Counter::kIsRate);
