@@ -207,15 +207,14 @@ void Project(const StepContext& ctx, const Particles& P, const std::vector<Vec3>
   s.weight.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
   s.weighted.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
   // Each block on the thread that owns its particles, every slot's sums in colour order.
-  thread_local std::array<std::vector<Accum>, 8> buffers;  // one per nesting level
-  OrderedBlockScatter(
+  using Buffer = std::vector<Accum>;
+  OrderedBlockScatter<Buffer>(
       grid, kDim,
-      [&](size_t b, int level) {
-        ScatterBlock<kDim, K, kNode>(ctx, P, x_n, begin, end, grid, b, buffers[size_t(level)], s,
-                                     value, /*flush=*/false);
+      [&](size_t b, Buffer& buf) {
+        ScatterBlock<kDim, K, kNode>(ctx, P, x_n, begin, end, grid, b, buf, s, value,
+                                     /*flush=*/false);
       },
-      [&](size_t b, int level, int o) {
-        const std::vector<Accum>& buf = buffers[size_t(level)];
+      [&](size_t b, const Buffer& buf, int o) {
         ForPaddedNodesIn<Pad>(o, [&](int a, int bb, int c) { FlushSlot<Pad>(grid, b, buf, s, a, bb, c); });
       });
   // The node (cell) means q-bar_i = sum N m q / sum N m (4.30), once per slot, in place: the gather

@@ -109,15 +109,26 @@ void ForPaddedNodesIn(int o, const F& f) {
 // that reaches into itself and its 7 upper neighbours, and every node must receive the blocks'
 // sums in colour order, the order of the colour-phased loops (one thread runs those), so that the
 // result is bitwise the same for any thread count. The writers of a target block X are the blocks
-// X - o, o in {0,1}^3, one per colour; a block adds its sums into X once every writer of X of a
-// lower colour has (`written[X]`: one bit per colour, release/acquire). A thread takes its blocks
-// colour by colour; where it must wait on a writer no thread has started, it runs that block
-// itself, one buffer level deeper: each wait is on a strictly lower colour, so this ends (at most
-// 8 levels) and cannot deadlock, even when one thread runs every part.
-//   accumulate(b, level): fill the calling thread's buffer `level` (0..7) with block b's sums;
-//   add(b, level, o): add the part of that buffer in upper neighbour o into the grid.
-// Only blocks with particles (grid.block_begin) are visited.
-template <class Accumulate, class Add>
+// X - o, o in {0,1}^3, one per colour.
+//   accumulate(b, buf): fill buf (a Buffer) with block b's sums;
+//   add(b, buf, o): add the part of b's buffer in its upper neighbour o into the grid.
+// Only blocks with particles (grid.block_begin) are visited. On more than one thread, one of two
+// schedules, which give the same sums bitwise:
+// - Few blocks (at most kTwoPhaseBlocksPerThread per thread with particles, e.g. a 1e4-particle
+//   column's 36 blocks on 2 threads): every thread accumulates its own blocks into buffers kept
+//   per block, then, after one barrier, adds into each target block it owns the buffers of X's
+//   writers in colour order. Nothing waits on a single block, which the colour chains below do
+//   when a handful of blocks per colour are split over the threads. With more blocks the buffers
+//   (64 KB a block for P2G in 3-D) no longer stay in cache between the two phases: a
+//   1e5-particle column (96 blocks) ran P2G 12 % slower this way (docs/benchmarks.md).
+// - Otherwise: a block adds its sums into X once every writer of X of a lower colour has
+//   (`written[X]`: one bit per colour, release/acquire). A thread takes its blocks colour by
+//   colour; where it must wait on a writer no thread has started, it runs that block itself, into
+//   a buffer one level deeper: each wait is on a strictly lower colour, so this ends (at most 8
+//   levels) and cannot deadlock, even when one thread runs every part.
+inline constexpr size_t kTwoPhaseBlocksPerThread = 24;
+
+template <class Buffer, class Accumulate, class Add>
 void OrderedBlockScatter(const SparseGrid& grid, int dim, const Accumulate& accumulate,
                          const Add& add) {
   const size_t nb = grid.block_count();
@@ -125,43 +136,72 @@ void OrderedBlockScatter(const SparseGrid& grid, int dim, const Accumulate& accu
   const auto has_particles = [&](size_t b) { return grid.block_begin[b + 1] > grid.block_begin[b]; };
   const size_t parts = WorkerThreads();
   if (parts <= 1) {  // the colour-phased order itself
+    thread_local Buffer buf;
     for (int colour = 0; colour < 8; ++colour)
       for (int32_t b : grid.colour[colour]) {
         if (!has_particles(size_t(b))) continue;
-        accumulate(size_t(b), 0);
+        accumulate(size_t(b), buf);
         for (int o = 0; o < targets; ++o)
-          if (grid.neighbor[size_t(b)][o] >= 0) add(size_t(b), 0, o);
+          if (grid.neighbor[size_t(b)][o] >= 0) add(size_t(b), buf, o);
       }
     return;
   }
   // Scratch kept between calls (no allocation per step once grown): [X][colour], the block
-  // writing X or -1; the colours writing X; the colours added into X; state 1: claimed.
-  // Named through plain references: a thread_local named inside the lambdas below would be the
-  // worker thread's own (empty) copy.
+  // writing X or -1, and its neighbour index o; the colours writing X; the colours added into X;
+  // state 1: claimed; the two-phase buffers. Named through plain references: a thread_local
+  // named inside the lambdas below would be the worker thread's own copy.
   thread_local std::vector<std::array<int32_t, 8>> writer_scratch;
+  thread_local std::vector<std::array<int8_t, 8>> writer_o_scratch;
   thread_local std::vector<uint8_t> writers_scratch, written_scratch, state_scratch;
+  thread_local std::vector<Buffer> block_buffer_scratch;
   auto& writer = writer_scratch;
+  auto& writer_o = writer_o_scratch;
   auto& writers = writers_scratch;
   auto& written = written_scratch;
   auto& state = state_scratch;
   std::array<int32_t, 8> none;
   none.fill(-1);
   writer.assign(nb, none);
+  writer_o.resize(nb);
   writers.assign(nb, 0);
-  written.assign(nb, 0);
-  state.assign(nb, 0);
+  size_t blocks_with_particles = 0;
   for (size_t b = 0; b < nb; ++b) {
     if (!has_particles(b)) continue;
+    ++blocks_with_particles;
     const int c = BlockColour(grid, b);
     for (int o = 0; o < targets; ++o) {
       const int32_t x = grid.neighbor[b][o];
       if (x < 0) continue;
       writer[size_t(x)][c] = int32_t(b);
+      writer_o[size_t(x)][c] = int8_t(o);
       writers[size_t(x)] |= uint8_t(1u << c);
     }
   }
+  if (blocks_with_particles <= kTwoPhaseBlocksPerThread * parts) {
+    auto& buffers = block_buffer_scratch;
+    if (buffers.size() < nb) buffers.resize(nb);
+    ForEachPart(parts, [&](size_t t) {
+      const size_t end = OwnedBlockBegin(grid, t + 1, parts);
+      for (size_t b = OwnedBlockBegin(grid, t, parts); b < end; ++b)
+        if (has_particles(b)) accumulate(b, buffers[b]);
+    });
+    ForEachPart(parts, [&](size_t t) {  // each target's writers in colour order
+      const size_t end = OwnedBlockBegin(grid, t + 1, parts);
+      for (size_t x = OwnedBlockBegin(grid, t, parts); x < end; ++x)
+        for (uint8_t cs = writers[x]; cs != 0; cs &= uint8_t(cs - 1)) {
+          const int c = std::countr_zero(unsigned(cs));
+          const size_t b = size_t(writer[x][c]);
+          add(b, buffers[b], writer_o[x][c]);
+        }
+    });
+    return;
+  }
+  written.assign(nb, 0);
+  state.assign(nb, 0);
   const auto run = [&](const auto& self, size_t b, int level) -> void {
-    accumulate(b, level);
+    thread_local std::array<Buffer, 8> levels;  // the running thread's, one per nesting level
+    Buffer& buf = levels[size_t(level)];
+    accumulate(b, buf);
     const int c = BlockColour(grid, b);
     const uint8_t lower = uint8_t((1u << c) - 1);
     for (int o = 0; o < targets; ++o) {
@@ -178,7 +218,7 @@ void OrderedBlockScatter(const SparseGrid& grid, int dim, const Accumulate& accu
         else
           std::this_thread::yield();  // another thread is adding it now
       }
-      add(b, level, o);
+      add(b, buf, o);
       done.fetch_or(uint8_t(1u << c), std::memory_order_release);
     }
   };

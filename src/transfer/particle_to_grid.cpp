@@ -234,15 +234,14 @@ void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& gri
   const size_t threads = WorkerThreads();
   if constexpr (!kFields) {
     // Single field: each block on the thread that owns its particles (OrderedBlockScatter).
-    thread_local std::array<std::vector<NodeAccum>, 8> buffers;  // one per nesting level
-    OrderedBlockScatter(
+    using Buffer = std::vector<NodeAccum>;
+    OrderedBlockScatter<Buffer>(
         grid, kDim,
-        [&](size_t b, int level) {
-          ScatterBlock<kDim, K, kApic, kFull>(ctx, particles, grid, b, buffers[size_t(level)],
-                                              nullptr, 0, Pad::E, /*flush=*/false);
+        [&](size_t b, Buffer& buf) {
+          ScatterBlock<kDim, K, kApic, kFull>(ctx, particles, grid, b, buf, nullptr, 0, Pad::E,
+                                              /*flush=*/false);
         },
-        [&](size_t b, int level, int o) {
-          const std::vector<NodeAccum>& buf = buffers[size_t(level)];
+        [&](size_t b, const Buffer& buf, int o) {
           ForPaddedNodesIn<Pad>(o, [&](int a, int bb, int c) { FlushNode<Pad, kFull>(grid, b, buf, a, bb, c); });
         });
     return;

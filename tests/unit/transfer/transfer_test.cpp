@@ -10,6 +10,7 @@
 
 #include "core/parallel.h"
 #include "support/test_state.h"
+#include "transfer/owned_loops.h"
 #include "transfer/walls.h"
 
 namespace surge {
@@ -94,13 +95,26 @@ INSTANTIATE_TEST_SUITE_P(
                        ::testing::Values(2, 3)));
 
 // P2G on 1 thread (colour phases) and on 2, 3 and 4 (OrderedBlockScatter: each thread its own
-// blocks, ordered adds per target block; 3 and 4 threads oversubscribe this 2-core machine, so
-// threads wait on and take over each other's blocks) gives bitwise the same grid, in 2-D and 3-D
-// and with the MUSL re-map's momentum-only scatter.
+// blocks; 3 and 4 threads oversubscribe this 2-core machine) gives bitwise the same grid, in 2-D
+// and 3-D and with the MUSL re-map's momentum-only scatter. Both of OrderedBlockScatter's
+// schedules are covered: a ball of radius 1.5 m has more blocks with particles than its
+// two-phase limit for any of these thread counts in 3-D (ordered adds per target block, threads
+// waiting on and taking over each other's blocks), one of 0.25 m fewer (two phases).
 TEST(TransferTest, ParticleToGridIsBitwiseIndependentOfThreadCount) {
-  for (int dim : {2, 3}) {
+  for (const auto& [dim, radius] : {std::pair{2, 1.5}, std::pair{3, 1.5}, std::pair{3, 0.25}}) {
     Model m = testing::SmallModel(dim, ShapeFunction::kQuadraticBspline, TransferScheme::kApic, 0.05);
-    State s = testing::RandomState(dim, 20000, Vec3(0.3, 0.2, 0.1), 1.5, m.dx);
+    State s = testing::RandomState(dim, 20000, Vec3(0.3, 0.2, 0.1), radius, m.dx);
+    {
+      SparseGrid grid;
+      RebuildGrid(m, s.particles, grid);
+      size_t used = 0;
+      for (size_t b = 0; b < grid.block_count(); ++b)
+        used += grid.block_begin[b + 1] > grid.block_begin[b] ? 1 : 0;
+      if (dim == 3 && radius > 1)
+        ASSERT_GT(used, 4 * kTwoPhaseBlocksPerThread);
+      else if (dim == 3)
+        ASSERT_LE(used, 2 * kTwoPhaseBlocksPerThread);
+    }
     for (auto& S : s.particles.stress) S = Mat3::Random();
     const StepContext ctx = Context(m);
     std::vector<Real> mass[4];
@@ -121,9 +135,9 @@ TEST(TransferTest, ParticleToGridIsBitwiseIndependentOfThreadCount) {
     }
     for (int t = 1; t < 4; ++t) {
       ASSERT_EQ(mass[0].size(), mass[t].size());
-      EXPECT_TRUE(mass[0] == mass[t]) << dim << "-D, " << t + 1 << " threads";
-      EXPECT_TRUE(force[0] == force[t]) << dim << "-D, " << t + 1 << " threads";
-      EXPECT_TRUE(momentum[0] == momentum[t]) << dim << "-D, " << t + 1 << " threads";
+      EXPECT_TRUE(mass[0] == mass[t]) << dim << "-D, r = " << radius << ", " << t + 1 << " threads";
+      EXPECT_TRUE(force[0] == force[t]) << dim << "-D, r = " << radius << ", " << t + 1 << " threads";
+      EXPECT_TRUE(momentum[0] == momentum[t]) << dim << "-D, r = " << radius << ", " << t + 1 << " threads";
     }
   }
 }
