@@ -110,10 +110,11 @@ TEST(TransferTest, ParticleToGridIsBitwiseIndependentOfThreadCount) {
       size_t used = 0;
       for (size_t b = 0; b < grid.block_count(); ++b)
         used += grid.block_begin[b + 1] > grid.block_begin[b] ? 1 : 0;
-      if (dim == 3 && radius > 1)
+      if (dim == 3 && radius > 1) {
         ASSERT_GT(used, 4 * kTwoPhaseBlocksPerThread);
-      else if (dim == 3)
+      } else if (dim == 3) {
         ASSERT_LE(used, 2 * kTwoPhaseBlocksPerThread);
+      }
     }
     for (auto& S : s.particles.stress) S = Mat3::Random();
     const StepContext ctx = Context(m);
