@@ -120,7 +120,8 @@ void ForPaddedNodesIn(int o, const F& f) {
 //   writers in colour order. Nothing waits on a single block, which the colour chains below do
 //   when a handful of blocks per colour are split over the threads. With more blocks the buffers
 //   (64 KB a block for P2G in 3-D) no longer stay in cache between the two phases: a
-//   1e5-particle column (96 blocks) ran P2G 12 % slower this way (docs/benchmarks.md).
+//   1e5-particle column (96 blocks) ran P2G 5-12 % slower this way (docs/benchmarks.md). The
+//   buffers are numbered by the blocks with particles, so at most that limit of them is kept.
 // - Otherwise: a block adds its sums into X once every writer of X of a lower colour has
 //   (`written[X]`: one bit per colour, release/acquire). A thread takes its blocks colour by
 //   colour; where it must wait on a writer no thread has started, it runs that block itself, into
@@ -148,26 +149,30 @@ void OrderedBlockScatter(const SparseGrid& grid, int dim, const Accumulate& accu
   }
   // Scratch kept between calls (no allocation per step once grown): [X][colour], the block
   // writing X or -1, and its neighbour index o; the colours writing X; the colours added into X;
-  // state 1: claimed; the two-phase buffers. Named through plain references: a thread_local
+  // state 1: claimed; the two-phase buffers and each block's buffer (its rank among the blocks
+  // with particles). Named through plain references: a thread_local
   // named inside the lambdas below would be the worker thread's own copy.
   thread_local std::vector<std::array<int32_t, 8>> writer_scratch;
   thread_local std::vector<std::array<int8_t, 8>> writer_o_scratch;
   thread_local std::vector<uint8_t> writers_scratch, written_scratch, state_scratch;
   thread_local std::vector<Buffer> block_buffer_scratch;
+  thread_local std::vector<uint32_t> slot_scratch;
   auto& writer = writer_scratch;
   auto& writer_o = writer_o_scratch;
   auto& writers = writers_scratch;
   auto& written = written_scratch;
   auto& state = state_scratch;
+  auto& slot = slot_scratch;
   std::array<int32_t, 8> none;
   none.fill(-1);
   writer.assign(nb, none);
   writer_o.resize(nb);
   writers.assign(nb, 0);
+  slot.resize(nb);
   size_t blocks_with_particles = 0;
   for (size_t b = 0; b < nb; ++b) {
     if (!has_particles(b)) continue;
-    ++blocks_with_particles;
+    slot[b] = uint32_t(blocks_with_particles++);
     const int c = BlockColour(grid, b);
     for (int o = 0; o < targets; ++o) {
       const int32_t x = grid.neighbor[b][o];
@@ -179,11 +184,11 @@ void OrderedBlockScatter(const SparseGrid& grid, int dim, const Accumulate& accu
   }
   if (blocks_with_particles <= kTwoPhaseBlocksPerThread * parts) {
     auto& buffers = block_buffer_scratch;
-    if (buffers.size() < nb) buffers.resize(nb);
+    if (buffers.size() < blocks_with_particles) buffers.resize(blocks_with_particles);
     ForEachPart(parts, [&](size_t t) {
       const size_t end = OwnedBlockBegin(grid, t + 1, parts);
       for (size_t b = OwnedBlockBegin(grid, t, parts); b < end; ++b)
-        if (has_particles(b)) accumulate(b, buffers[b]);
+        if (has_particles(b)) accumulate(b, buffers[slot[b]]);
     });
     ForEachPart(parts, [&](size_t t) {  // each target's writers in colour order
       const size_t end = OwnedBlockBegin(grid, t + 1, parts);
@@ -191,7 +196,7 @@ void OrderedBlockScatter(const SparseGrid& grid, int dim, const Accumulate& accu
         for (uint8_t cs = writers[x]; cs != 0; cs &= uint8_t(cs - 1)) {
           const int c = std::countr_zero(unsigned(cs));
           const size_t b = size_t(writer[x][c]);
-          add(b, buffers[b], writer_o[x][c]);
+          add(b, buffers[slot[b]], writer_o[x][c]);
         }
     });
     return;
