@@ -68,26 +68,35 @@ void MarkWallContacts(const Model& model, const StepContext& ctx, const Particle
   const Real v0_max = *std::max_element(v0_part.begin(), v0_part.end());
   const Real touch_max =
       0.75 * (model.dim == 3 ? std::cbrt(v0_max) : std::sqrt(v0_max)) * (1 + 1e-9) + 1e-12 * ctx.dx;
-  const auto near_a_wall = [&](size_t blk) {
+  // The walls near block blk, one bit each: only those are tested for its particles (a block
+  // of a column standing in a corner is near one or two of the five walls).
+  const auto walls_near = [&](size_t blk) {
+    unsigned near = 0;
     for (int k = 0; k < wall_count; ++k) {
       const int a = walls[k].axis;
       const Real lo = (grid.block_origin[blk][a] - 1) * ctx.dx, hi = lo + (kBlockDim + 4) * ctx.dx;
       const Real d_min = walls[k].sign > 0 ? lo - walls[k].level : walls[k].level - hi;
-      if (d_min <= touch_max) return true;
+      if (d_min <= touch_max) near |= 1u << k;
     }
-    return false;
+    return near;
   };
   // Find the touching particles in parallel (per chunk of blocks, in block and particle order),
   // mark serially: the marks are a set, so the result is the same for any thread count.
-  ParallelChunks(grid.block_count(), [&](size_t chunk, size_t b_begin, size_t b_end) {
+  // Chunk c takes the blocks of particles [n c / C, n (c + 1) / C), so the threads get equal
+  // shares of particles and keep the ones they own (transfer/owned_loops.h).
+  ParallelChunks(grid.block_count(), [&](size_t chunk, size_t, size_t) {
+    const size_t b_begin = OwnedBlockBegin(grid, chunk, kReductionChunks);
+    const size_t b_end = OwnedBlockBegin(grid, chunk + 1, kReductionChunks);
     std::vector<uint32_t>& out = grid.touch_scratch[chunk];
     out.clear();
     for (size_t blk = b_begin; blk < b_end; ++blk) {
-      if (grid.block_begin[blk] == grid.block_begin[blk + 1] || !near_a_wall(blk)) continue;
+      if (grid.block_begin[blk] == grid.block_begin[blk + 1]) continue;
+      const unsigned near = walls_near(blk);
+      if (near == 0) continue;
       for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
         const size_t p = grid.sorted[s];
         for (int k = 0; k < wall_count; ++k)
-          if (touches(p, k)) out.push_back(uint32_t(p) * 8 + uint32_t(k));
+          if ((near >> k & 1u) && touches(p, k)) out.push_back(uint32_t(p) * 8 + uint32_t(k));
       }
     }
   });
@@ -96,8 +105,11 @@ void MarkWallContacts(const Model& model, const StepContext& ctx, const Particle
       const size_t p = entry / 8;
       const int k = int(entry % 8);
       SparseGrid::WallTouch& t = grid.wall_touch[k];
-      const Real half = 0.5 * (model.dim == 3 ? std::cbrt(P.volume0[p]) : std::sqrt(P.volume0[p]));
-      const Real r = model.shape == ShapeFunction::kGimp ? reach + half : reach;
+      // GIMP: the particle's half width adds to the reach (only there: the root is not free).
+      const Real r = model.shape != ShapeFunction::kGimp
+                         ? reach
+                         : reach + 0.5 * (model.dim == 3 ? std::cbrt(P.volume0[p])
+                                                         : std::sqrt(P.volume0[p]));
       int range[2][2];  // node index range along the two tangential axes
       for (int j = 1; j <= 2; ++j) {
         const int a = (t.axis + j) % 3;
