@@ -38,7 +38,7 @@ Real StressPowerOf(const SymMat3& stress, const Mat3& l, Real J, Real V0) {
 template <class Pm>
 void UpdateOne(const Pm& params, Real dt, size_t p, const Mat3& L, Particles& P) {
   const Mat3 f = Increment(dt, L);  // (2.18)
-  P.F[p] = f * P.F[p];
+  P.F[p] = Mul(f, P.F[p]);  // F_{n+1} = f F_n (2.18)
   if constexpr (std::is_same_v<Pm, LinearElasticParams>) {
     Mat3 stress = P.stress[p];
     LinearElasticUpdate(params, Sym(f - Mat3::Identity()), stress, P.strain[p]);
@@ -93,7 +93,7 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
         const Mat3& L = grad(k0 + i);
         if (energy) before[i] = power_of(p[i], L, P.F[p[i]].determinant());
         f[i] = Increment(dt, L);  // (2.18)
-        P.F[p[i]] = f[i] * P.F[p[i]];
+        P.F[p[i]] = Mul(f[i], P.F[p[i]]);  // F_{n+1} = f F_n (2.18)
         b[i] = P.elastic_b[p[i]];  // b^e stored as its 6 components
       }
       HenckyTrial t[2];
