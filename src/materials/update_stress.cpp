@@ -46,15 +46,15 @@ void UpdateOne(const Pm& params, Real dt, size_t p, const Mat3& L, Particles& P)
   } else if constexpr (std::is_same_v<Pm, NeoHookeanParams>) {
     P.stress[p] = NeoHookeanStress(params, P.F[p]);
   } else if constexpr (std::is_same_v<Pm, NewtonianFluidParams>) {
-    P.stress[p] = NewtonianFluidStress(params, P.F[p].determinant(), L);  // (6.1)-(6.2)
+    P.stress[p] = NewtonianFluidStress(params, Det3(P.F[p]), L);  // (6.1)-(6.2)
   } else {
     static_assert(std::is_same_v<Pm, BinghamFluidParams> || std::is_same_v<Pm, FrictionalFluidParams>);
     Mat3 stress;
     History h = P.history.Get(p);
     if constexpr (std::is_same_v<Pm, BinghamFluidParams>)
-      BinghamFluidUpdate(params, P.F[p].determinant(), L, dt, h, stress);  // A3D (7.37)
+      BinghamFluidUpdate(params, Det3(P.F[p]), L, dt, h, stress);  // A3D (7.37)
     else
-      FrictionalFluidUpdate(params, P.F[p].determinant(), L, dt, h, stress);  // A3D (7.38)
+      FrictionalFluidUpdate(params, Det3(P.F[p]), L, dt, h, stress);  // A3D (7.38)
     P.history.Set(p, h);
     P.stress[p] = stress;
   }
@@ -91,7 +91,7 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
       for (size_t i = 0; i < n; ++i) {
         p[i] = index(k0 + i);
         const Mat3& L = grad(k0 + i);
-        if (energy) before[i] = power_of(p[i], L, P.F[p[i]].determinant());
+        if (energy) before[i] = power_of(p[i], L, Det3(P.F[p[i]]));
         f[i] = Increment(dt, L);  // (2.18)
         P.F[p[i]] = Mul(f[i], P.F[p[i]]);  // F_{n+1} = f F_n (2.18)
         b[i] = P.elastic_b[p[i]];  // b^e stored as its 6 components
@@ -105,7 +105,7 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
       for (size_t i = 0; i < n; ++i) {
         Mat3 stress;
         History h = P.history.Get(p[i]);  // the run's slots, the rest zero
-        const Real J = P.F[p[i]].determinant();
+        const Real J = Det3(P.F[p[i]]);
         PlasticUpdate(params, f[i], t[i], J, b[i], h, stress);
         P.history.Set(p[i], h);
         P.elastic_b[p[i]] = b[i];
@@ -118,10 +118,10 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
     for (size_t k = k_begin; k < k_end; ++k) {
       const size_t p = index(k);
       const Mat3& L = grad(k);
-      const Real before = energy ? power_of(p, L, P.F[p].determinant()) : 0.0;
+      const Real before = energy ? power_of(p, L, Det3(P.F[p])) : 0.0;
       UpdateOne(params, dt, p, L, P);
       if (energy || checks) {
-        const Real J = P.F[p].determinant();
+        const Real J = Det3(P.F[p]);
         if (energy) sum += before + power_of(p, L, J);
         if (checks) checks->Test(P, p, J);
       }
@@ -203,12 +203,12 @@ Real EnergyDensityOf(const Pm& p, const Mat3& F, const SymMat3& stress, const Ma
   } else if constexpr (std::is_same_v<Pm, NeoHookeanParams>) {
     return NeoHookeanEnergy(p, F);
   } else if constexpr (std::is_same_v<Pm, NewtonianFluidParams>) {
-    return NewtonianFluidEnergy(p, F.determinant());
+    return NewtonianFluidEnergy(p, Det3(F));
   } else if constexpr (std::is_same_v<Pm, BinghamFluidParams> ||
                        std::is_same_v<Pm, FrictionalFluidParams>) {
-    return NewtonianFluidEnergy(EquationOfStateOf(p), F.determinant());  // EOS part only
+    return NewtonianFluidEnergy(EquationOfStateOf(p), Det3(F));  // EOS part only
   } else {  // elastoplastic: Hencky energy of b^e (3.45)
-    return HenckyEnergy(p.bulk_modulus, p.shear_modulus, F.determinant(), stress);
+    return HenckyEnergy(p.bulk_modulus, p.shear_modulus, Det3(F), stress);
   }
 }
 

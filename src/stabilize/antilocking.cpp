@@ -36,7 +36,7 @@ struct Accum {
 template <int kDim>
 Real Det(const Mat3& a) {
   if constexpr (kDim == 2) return a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
-  return a.determinant();
+  return Det3(a);
 }
 
 // Trial volumetric strain theta_p = tr(1/2 log b^tr) = ln det f + ln J_n (seed (4.36)-(4.38) and
@@ -652,7 +652,7 @@ void ProjectFullTensorStress(const StepContext& ctx, Particles& P, const std::ve
   s.tensor_ok.resize(n);
   ParallelFor(end - begin, 1024, [&](size_t i) {
     const size_t p = begin + i;
-    const Real J = P.F[p].determinant();
+    const Real J = Det3(P.F[p]);
     s.tensor[p] = (J * P.volume0[p] / P.mass[p]) * P.stress[p].matrix();  // tau / rho0 (3.37)
     s.tensor_ok[p] = J > 0 && s.tensor[p].allFinite();  // else left to CheckState
   });
@@ -665,7 +665,7 @@ void ProjectFullTensorStress(const StepContext& ctx, Particles& P, const std::ve
       const Mat3& own = s.tensor[p];
       q(2, 2) += 0.5 * ((q_h(0, 0) + q_h(1, 1)) - (own(0, 0) + own(1, 1)));
     }
-    const Mat3 sigma = (P.mass[p] / (P.volume0[p] * P.F[p].determinant())) * q;
+    const Mat3 sigma = (P.mass[p] / (P.volume0[p] * Det3(P.F[p]))) * q;
     if (sigma.allFinite()) P.stress[p] = sigma;
   });
 }
@@ -829,12 +829,12 @@ void ProjectStress(const Model& model, const StepContext& ctx,
       // (4.29)_2 with M = [1 1 1 0 0 0]): q_p = tr(tau_p) / (3 rho0_p), tau = J sigma (3.37),
       // rho0_p = m_p / V0_p.
       const auto mean_specific = [&](size_t p) {
-        return P.F[p].determinant() * P.volume0[p] * P.stress[p].trace() / (3.0 * P.mass[p]);
+        return Det3(P.F[p]) * P.volume0[p] * P.stress[p].trace() / (3.0 * P.mass[p]);
       };
       // Step 7 with P = I_dev: sigma_p <- sigma_p + (rho0_p q-bar_p / J_p - tr(sigma_p)/3) 1,
       // the deviator kept (4.28), (4.32)_2.
       const auto replace = [&](size_t p, Real q_bar) {
-        const Real mean = q_bar * P.mass[p] / (P.volume0[p] * P.F[p].determinant());
+        const Real mean = q_bar * P.mass[p] / (P.volume0[p] * Det3(P.F[p]));
         const Real shift = mean - P.stress[p].trace() / 3.0;
         for (int d = 0; d < 3; ++d) P.stress[p].v[d] += shift;
       };

@@ -34,7 +34,7 @@ void ComputeBulkViscosity(const Model& model, const StepContext& ctx,
         const Real trd = L[p].trace();  // tr d = tr L: the volumetric strain rate [1/s]
         Real Q = bv.linear * c;         // LS-DYNA time step: Q = c1 c + c0 l |tr d| (compression)
         if (trd < 0) {
-          const Real rho = P.mass[p] / (P.volume0[p] * P.F[p].determinant());  // current density
+          const Real rho = P.mass[p] / (P.volume0[p] * Det3(P.F[p]));  // current density
           // von Neumann-Richtmyer quadratic + Landshoff linear term in the form of Wilkins (1980)
           // and the LS-DYNA Theory Manual ("Bulk viscosity"): q = rho l (c0 l trd^2 - c1 c trd).
           scratch.q[p] = rho * l * (bv.quadratic * l * trd * trd - bv.linear * c * trd);

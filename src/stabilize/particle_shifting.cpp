@@ -21,7 +21,7 @@ using K = QuadraticBsplineKernel;
 template <int kDim>
 Real Det(const Mat3& a) {
   if constexpr (kDim == 2) return a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
-  return a.determinant();
+  return Det3(a);
 }
 
 // Whether particle p belongs to a material that shifts (the groups are few: a linear scan).

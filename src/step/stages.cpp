@@ -115,7 +115,7 @@ void ObstacleProjectionStage(const Model& m, const StepContext& c, State& s, Wor
   EndChecks checks{DomainBox::Of(m)};
   for (const auto& list : w.contact.moved)
     for (const ProjectedParticle& moved : list)
-      checks.Test(s.particles, moved.particle, s.particles.F[moved.particle].determinant());
+      checks.Test(s.particles, moved.particle, Det3(s.particles.F[moved.particle]));
   w.end_checks_passed = checks.clean;
 }
 
@@ -472,7 +472,7 @@ void DescribeUnhealthy(const Model& m, const StepContext& ctx, const State& s, s
   const Real dt_wave = c_max > 0 ? ctx.dx / c_max : 0;  // CFL limit at rest (C = 1) [s]
   const Real courant = c_max > 0 ? ctx.dt * c_max / ctx.dx : 0;
   const Real speed = P.v[p].allFinite() ? P.v[p].norm() : std::numeric_limits<Real>::infinity();
-  const Real J = P.F[p].allFinite() ? P.F[p].determinant() : std::numeric_limits<Real>::quiet_NaN();
+  const Real J = P.F[p].allFinite() ? Det3(P.F[p]) : std::numeric_limits<Real>::quiet_NaN();
   const bool musl = m.scheme == UpdateScheme::kMusl;
 
   switch (field) {
@@ -571,12 +571,12 @@ void CheckStateStage(const Model& m, const StepContext& ctx, State& s, Workspace
   std::array<size_t, kReductionChunks> bad{};
   ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
     for (size_t p = b; p < e; ++p) {
-      if (SurelyHealthy(P, p, P.F[p].determinant())) continue;
+      if (SurelyHealthy(P, p, Det3(P.F[p]))) continue;
       int field = kFieldOk;
       if (!P.v[p].allFinite()) field = kFieldV;
       else if (!P.x[p].allFinite()) field = kFieldX;
       else if (!P.F[p].allFinite()) field = kFieldF;
-      else if (!(P.F[p].determinant() > 0)) field = kFieldJ;
+      else if (!(Det3(P.F[p]) > 0)) field = kFieldJ;
       else if (!P.stress[p].allFinite()) field = kFieldStress;
       if (field == kFieldOk) continue;
       ++bad[chunk];

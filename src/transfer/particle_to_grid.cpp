@@ -115,7 +115,7 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
     Mat3 neg_vs = Mat3::Zero();
     Vec3 fext = Vec3::Zero();
     if constexpr (kFull) {
-      neg_vs = -(P.volume0[p] * P.F[p].determinant()) * P.stress[p].matrix();
+      neg_vs = -(P.volume0[p] * Det3(P.F[p])) * P.stress[p].matrix();
       if (P.layout.ext_force)
         fext = ctx.ramp * P.ext_force[p];  // particle tractions (App. B.2.9), ramped (App. B.2.3)
     }
