@@ -82,6 +82,37 @@ void FindOwnerBlocks(SparseGrid& grid) {
   });
 }
 
+// BinParticles' stable counting sort in parallel over the fixed particle chunks: each chunk
+// counts its particles per block, the chunks' cursors are laid out block by block and, within a
+// block, chunk by chunk (particle order), and each chunk then places its particles. The order is
+// that of the serial sort, for any thread count.
+void BinInChunks(SparseGrid& grid) {
+  const size_t n = grid.particle_block.size();
+  const size_t nb = grid.block_count();
+  std::vector<uint32_t>& cursor = grid.chunk_cursor;  // [chunk * nb + block]
+  cursor.resize(kReductionChunks * nb);
+  ParallelChunks(n, [&](size_t c, size_t begin, size_t end) {
+    uint32_t* count = cursor.data() + c * nb;
+    std::fill(count, count + nb, 0u);
+    for (size_t p = begin; p < end; ++p) ++count[grid.particle_block[p]];
+  });
+  grid.block_begin.resize(nb + 1);
+  uint32_t next = 0;
+  for (size_t b = 0; b < nb; ++b) {
+    grid.block_begin[b] = next;
+    for (size_t c = 0; c < kReductionChunks; ++c) {
+      const uint32_t count = cursor[c * nb + b];
+      cursor[c * nb + b] = next;
+      next += count;
+    }
+  }
+  grid.block_begin[nb] = next;
+  ParallelChunks(n, [&](size_t c, size_t begin, size_t end) {
+    uint32_t* at = cursor.data() + c * nb;
+    for (size_t p = begin; p < end; ++p) grid.sorted[at[grid.particle_block[p]]++] = uint32_t(p);
+  });
+}
+
 }  // namespace
 
 void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& grid) {
@@ -113,13 +144,19 @@ void BinParticles(SparseGrid& grid) {
   // are independent of the thread count (spike note, "Determinism").
   const size_t n = grid.particle_block.size();
   const size_t nb = grid.block_count();
-  grid.block_begin.assign(nb + 1, 0);
-  for (size_t p = 0; p < n; ++p) ++grid.block_begin[grid.particle_block[p] + 1];
-  for (size_t b = 0; b < nb; ++b) grid.block_begin[b + 1] += grid.block_begin[b];
   grid.sorted.resize(n);
-  std::vector<uint32_t>& cursor = grid.chunk_cursor;
-  cursor.assign(grid.block_begin.begin(), grid.block_begin.end() - 1);
-  for (size_t p = 0; p < n; ++p) grid.sorted[cursor[grid.particle_block[p]]++] = uint32_t(p);
+  std::vector<uint32_t>& cursor = grid.chunk_cursor;  // [chunk * nb + block]
+  if (kReductionChunks * nb > n / 4) {
+    // Many blocks for the particles (sparse or small runs): the per-chunk tables would cost more
+    // than they save. The serial sort, the same order.
+    grid.block_begin.assign(nb + 1, 0);
+    for (size_t p = 0; p < n; ++p) ++grid.block_begin[grid.particle_block[p] + 1];
+    for (size_t b = 0; b < nb; ++b) grid.block_begin[b + 1] += grid.block_begin[b];
+    cursor.assign(grid.block_begin.begin(), grid.block_begin.end() - 1);
+    for (size_t p = 0; p < n; ++p) grid.sorted[cursor[grid.particle_block[p]]++] = uint32_t(p);
+  } else {
+    BinInChunks(grid);
+  }
 
   // Gather work items: one run per non-empty block, cut into runs of at most n / 16 particles
   // (never below 256: each run gathers its block's node halo once), so that up to 4 threads

@@ -94,6 +94,42 @@ INSTANTIATE_TEST_SUITE_P(
                                          TransferScheme::kApic),
                        ::testing::Values(2, 3)));
 
+// BinParticles' stable counting sort, serial (many blocks for the particles) and in chunks (at
+// most n / 256 blocks): every block's particles in index order, the blocks in block order, and
+// the same arrays for 1, 2 and 3 threads.
+TEST(TransferTest, BinningIsAStableSortByBlockForAnyThreadCount) {
+  for (const auto& [n, dx] : {std::pair{size_t(3000), 0.1}, std::pair{size_t(60000), 0.25}}) {
+    const Model m = testing::SmallModel(3, ShapeFunction::kQuadraticBspline, TransferScheme::kApic, dx);
+    const State s = testing::RandomState(3, n, Vec3(-0.4, 0.3, 0.2), 1.3, m.dx);
+    std::vector<uint32_t> sorted[3], begin[3];
+    for (int t = 0; t < 3; ++t) {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, t + 1);
+      tbb::task_arena arena(t + 1);
+      arena.execute([&] {
+        SparseGrid grid;
+        RebuildGrid(m, s.particles, grid);
+        const size_t nb = grid.block_count();
+        const bool chunked = kReductionChunks * nb <= n / 4;
+        EXPECT_EQ(chunked, n > 10000) << "n = " << n << ", " << nb << " blocks";
+        ASSERT_EQ(grid.block_begin.size(), nb + 1);
+        ASSERT_EQ(grid.block_begin[nb], n);
+        for (size_t b = 0; b < nb; ++b)
+          for (uint32_t k = grid.block_begin[b]; k < grid.block_begin[b + 1]; ++k) {
+            ASSERT_EQ(size_t(grid.particle_block[grid.sorted[k]]), b);
+            if (k > grid.block_begin[b]) {
+              ASSERT_LT(grid.sorted[k - 1], grid.sorted[k]);
+            }
+          }
+        sorted[t] = grid.sorted;
+        begin[t] = grid.block_begin;
+      });
+    }
+    EXPECT_EQ(sorted[1], sorted[0]);
+    EXPECT_EQ(sorted[2], sorted[0]);
+    EXPECT_EQ(begin[1], begin[0]);
+  }
+}
+
 // P2G on 1 thread (colour phases) and on 2, 3 and 4 (OrderedBlockScatter: each thread its own
 // blocks; 3 and 4 threads oversubscribe this 2-core machine) gives bitwise the same grid, in 2-D
 // and 3-D and with the MUSL re-map's momentum-only scatter. Both of OrderedBlockScatter's
