@@ -41,10 +41,9 @@ inline Mat3 Increment(Real dt, const Mat3& L) {
 // det(a), inline: bitwise Eigen's `a.determinant()` for 3x3 (its cofactor expansion along the
 // first row, in its order), which GCC called out of line in the particle loops.
 [[gnu::always_inline]] inline Real Det3(const Mat3& a) {
-  const auto minor = [&](int c0, int c1, int c2) {
-    return a(0, c0) * (a(1, c1) * a(2, c2) - a(1, c2) * a(2, c1));
-  };
-  return minor(0, 1, 2) - minor(1, 0, 2) + minor(2, 0, 1);
+  return a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) -
+         a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
+         a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
 }
 
 // Symmetric part of a 3x3 matrix.

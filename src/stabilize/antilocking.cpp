@@ -34,7 +34,7 @@ struct Accum {
 
 // Determinant; in 2-D (plane strain) of the in-plane block only.
 template <int kDim>
-Real Det(const Mat3& a) {
+[[gnu::always_inline]] inline Real Det(const Mat3& a) {
   if constexpr (kDim == 2) return a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
   return Det3(a);
 }
