@@ -98,7 +98,9 @@ INSTANTIATE_TEST_SUITE_P(
 // most n / 256 blocks): every block's particles in index order, the blocks in block order, and
 // the same arrays for 1, 2 and 3 threads.
 TEST(TransferTest, BinningIsAStableSortByBlockForAnyThreadCount) {
-  for (const auto& [n, dx] : {std::pair{size_t(3000), 0.1}, std::pair{size_t(60000), 0.25}}) {
+  for (const auto& [count, cell] : {std::pair{size_t(3000), 0.1}, std::pair{size_t(60000), 0.25}}) {
+    const size_t n = count;  // a plain variable: lambdas may not capture structured bindings (C++17)
+    const Real dx = cell;
     const Model m = testing::SmallModel(3, ShapeFunction::kQuadraticBspline, TransferScheme::kApic, dx);
     const State s = testing::RandomState(3, n, Vec3(-0.4, 0.3, 0.2), 1.3, m.dx);
     std::vector<uint32_t> sorted[3], begin[3];
