@@ -145,10 +145,10 @@ void BinParticles(SparseGrid& grid) {
   const size_t n = grid.particle_block.size();
   const size_t nb = grid.block_count();
   grid.sorted.resize(n);
-  std::vector<uint32_t>& cursor = grid.chunk_cursor;  // [chunk * nb + block]
   if (kReductionChunks * nb > n / 4) {
-    // Many blocks for the particles (sparse or small runs): the per-chunk tables would cost more
-    // than they save. The serial sort, the same order.
+    // More than n / 256 blocks (sparse or small runs): the per-chunk tables would cost more than
+    // they save. The serial sort, the same order; the cursors are one per block.
+    std::vector<uint32_t>& cursor = grid.chunk_cursor;
     grid.block_begin.assign(nb + 1, 0);
     for (size_t p = 0; p < n; ++p) ++grid.block_begin[grid.particle_block[p] + 1];
     for (size_t b = 0; b < nb; ++b) grid.block_begin[b + 1] += grid.block_begin[b];
