@@ -11,7 +11,7 @@ namespace {
 
 // b^e_tr = f b^e_n f^T (3.35): with b^e_n symmetric the result is, so only its 6 distinct
 // entries are formed (rows of f b^e_n dotted with rows of f).
-Mat3 TrialB(const Mat3& f, const Mat3& elastic_b) {
+[[gnu::always_inline]] inline Mat3 TrialB(const Mat3& f, const Mat3& elastic_b) {
   const Mat3 fb = f * elastic_b;
   const Vec3 f0 = f.row(0).transpose(), f1 = f.row(1).transpose(), f2 = f.row(2).transpose();
   const Vec3 a0 = fb.row(0).transpose(), a1 = fb.row(1).transpose();
@@ -25,7 +25,7 @@ Mat3 TrialB(const Mat3& f, const Mat3& elastic_b) {
 }
 
 // Steps 3-4 of Table 3.4 from the decomposition of b^e_tr (step 2).
-void TrialFromPrincipal(Real K, Real G, const Vec3& b_principal, HenckyTrial& t) {
+[[gnu::always_inline]] inline void TrialFromPrincipal(Real K, Real G, const Vec3& b_principal, HenckyTrial& t) {
   t.eps = 0.5 * b_principal.array().log();  // (3.34), erratum 2
   t.tau = HenckyStress(K, G, t.eps);
 }
@@ -49,27 +49,6 @@ void HenckyTrialStates(Real K, Real G, const Mat3& f0, const Mat3& elastic_b0, c
   SymmetricEigen2(t0.b, t1.b, b0, t0.Q, b1, t1.Q);  // Table 3.4, step 2
   TrialFromPrincipal(K, G, b0, t0);
   TrialFromPrincipal(K, G, b1, t1);
-}
-
-Vec3 HenckyStress(Real K, Real G, const Vec3& eps) {
-  const Real theta = eps.sum();
-  return (2.0 * G * (eps.array() - theta / 3.0) + K * theta).matrix();  // [C^e_d] eps
-}
-
-Vec3 HenckyStrain(Real K, Real G, const Vec3& tau) {
-  const Real tr = tau.sum();
-  return (tr / (9.0 * K) + (tau.array() - tr / 3.0) / (2.0 * G)).matrix();  // [D^e_d] tau
-}
-
-void HenckyFinish(const HenckyTrial& t, Real K, Real G, const Vec3& tau, Real J,
-                  Mat3& elastic_b, Mat3& stress) {
-  if (tau == t.tau) {
-    elastic_b = t.b;  // elastic step: b^e_{n+1} = b^e_tr
-  } else {
-    const Vec3 eps_e = HenckyStrain(K, G, tau);
-    elastic_b = FromPrincipal(t.Q, (2.0 * eps_e).array().exp().matrix());  // Table 3.4, 5(c)
-  }
-  stress = FromPrincipal(t.Q, tau) / J;                                   // 5(d), (3.37)
 }
 
 Mat3 ExpTwice(const Mat3& eps) {

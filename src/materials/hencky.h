@@ -28,18 +28,25 @@ void HenckyTrialStates(Real K, Real G, const Mat3& f0, const Mat3& elastic_b0, c
                        const Mat3& elastic_b1, HenckyTrial& t0, HenckyTrial& t1);
 
 // Principal Kirchhoff stress of principal Hencky strains: tau_i = K tr(eps) + 2G (eps_i - tr/3)
-// ([C^e_d], spec §2.0, with the factor 2 of erratum 1).
-Vec3 HenckyStress(Real K, Real G, const Vec3& eps);
+// ([C^e_d], spec §2.0, with the factor 2 of erratum 1). Inline, as the two below: they run once
+// or twice per particle and step inside every elastoplastic update.
+[[gnu::always_inline]] inline Vec3 HenckyStress(Real K, Real G, const Vec3& eps) {
+  const Real theta = eps.sum();
+  return (2.0 * G * (eps.array() - theta / 3.0) + K * theta).matrix();  // [C^e_d] eps
+}
 
 // Inverse: eps_i = tr(tau)/(9K) + (tau_i - tr(tau)/3)/(2G) ([D^e_d], compliance (3.47)).
-Vec3 HenckyStrain(Real K, Real G, const Vec3& tau);
+[[gnu::always_inline]] inline Vec3 HenckyStrain(Real K, Real G, const Vec3& tau) {
+  const Real tr = tau.sum();
+  return (tr / (9.0 * K) + (tau.array() - tr / 3.0) / (2.0 * G)).matrix();  // [D^e_d] tau
+}
 
 // Steps 5(c)-(d) of Table 3.4 and (3.37): b^e_{n+1} = sum exp(2 eps^e_i) m^(i) with
 // eps^e = [D^e_d] tau, and sigma_{n+1} = (sum tau_i m^(i)) / J. An elastic step (tau is the
 // trial stress, bitwise) keeps b^e_{n+1} = b^e_tr, which the formula reproduces in exact
 // arithmetic (eps^e = eps_tr, exp(2 eps_tr,i) = b_i), without the exponentials.
-void HenckyFinish(const HenckyTrial& trial, Real K, Real G, const Vec3& tau, Real J,
-                  Mat3& elastic_b, Mat3& stress);
+inline void HenckyFinish(const HenckyTrial& trial, Real K, Real G, const Vec3& tau, Real J,
+                         Mat3& elastic_b, Mat3& stress);
 
 // Elastic b^e for a Kirchhoff stress: eps_e = D^e : tau (3.47), b^e = exp(2 eps_e) (4.40).
 // Used for a prescribed (geostatic) initial stress at F = I, where tau = sigma.
@@ -68,6 +75,17 @@ inline Mat3 FromPrincipal(const Mat3& Q, const Vec3& v) {
       m01, m11, m12,   //
       m02, m12, m22;
   return m;
+}
+
+inline void HenckyFinish(const HenckyTrial& t, Real K, Real G, const Vec3& tau, Real J,
+                         Mat3& elastic_b, Mat3& stress) {
+  if (tau == t.tau) {
+    elastic_b = t.b;  // elastic step: b^e_{n+1} = b^e_tr
+  } else {
+    const Vec3 eps_e = HenckyStrain(K, G, tau);
+    elastic_b = FromPrincipal(t.Q, (2.0 * eps_e).array().exp().matrix());  // Table 3.4, 5(c)
+  }
+  stress = FromPrincipal(t.Q, tau) / J;  // 5(d), (3.37)
 }
 
 }  // namespace surge
