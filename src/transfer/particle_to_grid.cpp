@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <type_traits>
 
 #include "core/check.h"
@@ -82,10 +83,13 @@ void FlushNode(SparseGrid& grid, size_t blk, const std::vector<NodeAccum>& buf, 
 // Pad::E). Calls on disjoint slabs of one block may run in parallel: each node still sums the
 // block's particles in their sorted order, so the result is the same bitwise for any split.
 // flush = false: only accumulate into buf (OrderedBlockScatter then adds it into the grid).
-template <int kDim, class K, bool kApic, bool kFull, bool kFields = false>
-void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, size_t blk,
-                  std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>>& buf,
-                  const int* body_field, int xlo, int xhi, bool flush = true) {
+// kWide: the single field's node updates as two Real4 (AVX build, ScatterBlockWide) instead of
+// four Real2, lane for lane the same operations (core/simd.h).
+template <int kDim, class K, bool kApic, bool kFull, bool kFields, bool kWide>
+[[gnu::always_inline]] inline void ScatterBlockImpl(
+    const StepContext& ctx, const Particles& P, SparseGrid& grid, size_t blk,
+    std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>>& buf, const int* body_field,
+    int xlo, int xhi, bool flush) {
   using Pad = BlockPad<kDim, K>;
   using Accum = std::conditional_t<kFields, FieldAccum, NodeAccum>;
   const int fields = kFields ? grid.field_count : 1;
@@ -130,6 +134,15 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
       v_s[c][0] = Real2{neg_vs(0, c), neg_vs(1, c)};
       v_s[c][1] = Real2{neg_vs(2, c), 0.0};
     }
+    // The same lanes as Real4 for the wide build: (m, m v), (0, mC[:,c]), (S[:,c], 0), (f_ext, 0).
+    [[maybe_unused]] const Real4 w_mv = {kFull ? m : 0.0, mv[0], mv[1], mv[2]},
+                                 w_fext = {fext.x(), fext.y(), fext.z(), 0.0};
+    [[maybe_unused]] const Real4 w_mc[3] = {{0.0, mC(0, 0), mC(1, 0), mC(2, 0)},
+                                            {0.0, mC(0, 1), mC(1, 1), mC(2, 1)},
+                                            {0.0, mC(0, 2), mC(1, 2), mC(2, 2)}};
+    [[maybe_unused]] const Real4 w_s[3] = {{neg_vs(0, 0), neg_vs(1, 0), neg_vs(2, 0), 0.0},
+                                           {neg_vs(0, 1), neg_vs(1, 1), neg_vs(2, 1), 0.0},
+                                           {neg_vs(0, 2), neg_vs(1, 2), neg_vs(2, 2), 0.0}};
     // Terms that depend on (i, j) or on k only are hoisted out of the inner loop. With
     // w = wxy w_k and oz_k = (x_i - x_p)_z:
     //   momentum  w (m v + mC (x_i - x_p)) = w_k a_ij + (w_k oz_k) b_ij,
@@ -164,6 +177,28 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
           // lane-wise operations only (no element inserts in the loop).
           const Real ox = off[0][i], oy = off[1][j];
           const Real gx = st.g[0][i] * st.w[1][j], gy = st.w[0][i] * st.g[1][j];
+          if constexpr (kWide) {
+            // (m, p) and (f, unused) as one Real4 each, lane for lane a[0..1] and a[2..3] below.
+            const Real4 a4[2] = {kApic ? wxy * (w_mv + ox * w_mc[0] + oy * w_mc[1]) : wxy * w_mv,
+                                 gx * w_s[0] + gy * w_s[1] + wxy * w_fext};
+            const Real4 b4[2] = {wxy * w_mc[2], wxy * w_s[2]};
+            for (int k = 0; k < st.Wz; ++k) {
+              const Real wk = st.w[2][k], wo = wk_oz[k], g2 = st.g[2][k];
+              Real4 n0, n1;
+              std::memcpy(&n0, row[k].v, sizeof n0);
+              if constexpr (kApic)
+                n0 += wk * a4[0] + wo * b4[0];  // APIC (Jiang et al. 2015, eq. (9))
+              else
+                n0 += wk * a4[0];
+              std::memcpy(row[k].v, &n0, sizeof n0);
+              if constexpr (kFull) {
+                std::memcpy(&n1, row[k].v + 2, sizeof n1);
+                n1 += wk * a4[1] + g2 * b4[1];  // (2.11) + traction
+                std::memcpy(row[k].v + 2, &n1, sizeof n1);
+              }
+            }
+            continue;
+          }
           Real2 a[4], b[4];
           for (int h = 0; h < 2; ++h) {
             a[h] = kApic ? wxy * (v_mv[h] + ox * v_mc[0][h] + oy * v_mc[1][h]) : wxy * v_mv[h];
@@ -227,6 +262,23 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, 
   }
 }
 
+// The two builds of ScatterBlockImpl: portable, and for AVX (core/simd.h).
+template <int kDim, class K, bool kApic, bool kFull, bool kFields = false>
+void ScatterBlock(const StepContext& ctx, const Particles& P, SparseGrid& grid, size_t blk,
+                  std::vector<std::conditional_t<kFields, FieldAccum, NodeAccum>>& buf,
+                  const int* body_field, int xlo, int xhi, bool flush = true) {
+  ScatterBlockImpl<kDim, K, kApic, kFull, kFields, false>(ctx, P, grid, blk, buf, body_field, xlo,
+                                                          xhi, flush);
+}
+#if SURGE_HAVE_WIDE_SIMD
+template <int kDim, class K, bool kApic, bool kFull>
+SURGE_TARGET_WIDE void ScatterBlockWide(const StepContext& ctx, const Particles& P,
+                                        SparseGrid& grid, size_t blk, std::vector<NodeAccum>& buf) {
+  ScatterBlockImpl<kDim, K, kApic, kFull, false, true>(ctx, P, grid, blk, buf, nullptr, 0,
+                                                       BlockPad<kDim, K>::E, false);
+}
+#endif
+
 template <int kDim, class K, bool kApic, bool kFull, bool kFields>
 void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& grid,
              const int* body_field) {
@@ -235,9 +287,13 @@ void Scatter(const StepContext& ctx, const Particles& particles, SparseGrid& gri
   if constexpr (!kFields) {
     // Single field: each block on the thread that owns its particles (OrderedBlockScatter).
     using Buffer = std::vector<NodeAccum>;
+    [[maybe_unused]] const bool wide = WideSimd();
     OrderedBlockScatter<Buffer>(
         grid, kDim,
         [&](size_t b, Buffer& buf) {
+#if SURGE_HAVE_WIDE_SIMD
+          if (wide) return ScatterBlockWide<kDim, K, kApic, kFull>(ctx, particles, grid, b, buf);
+#endif
           ScatterBlock<kDim, K, kApic, kFull>(ctx, particles, grid, b, buf, nullptr, 0, Pad::E,
                                               /*flush=*/false);
         },

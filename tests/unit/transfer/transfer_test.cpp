@@ -9,6 +9,7 @@
 #include <algorithm>
 
 #include "core/parallel.h"
+#include "core/simd.h"
 #include "support/test_state.h"
 #include "transfer/owned_loops.h"
 #include "transfer/walls.h"
@@ -347,6 +348,55 @@ TEST(TransferTest, DeferredAdvectionMatchesGridToParticleBitwise) {
       EXPECT_FALSE(s[1].particles.x == start.particles.x);  // they moved
     }
   }
+}
+
+// The wide (AVX) builds of P2G and G2P (core/simd.h) give bitwise the portable builds' node sums,
+// MUSL re-map, velocities, affine matrices, gradients and positions, for every kernel, transfer
+// and dimension. Skipped on a CPU without AVX, where only the portable builds run.
+TEST(TransferTest, WideKernelsMatchThePortableOnesBitwise) {
+  const bool was = SetWideSimd(true);
+  if (!WideSimd()) GTEST_SKIP() << "no AVX on this CPU";
+  for (int dim : {2, 3})
+    for (ShapeFunction shape : {ShapeFunction::kLinear, ShapeFunction::kQuadraticBspline,
+                                ShapeFunction::kCubicBspline, ShapeFunction::kGimp})
+      for (TransferScheme transfer : {TransferScheme::kApic, TransferScheme::kFlip}) {
+        Model m = testing::SmallModel(dim, shape, transfer, 0.05);
+        State start =
+            testing::RandomState(dim, 3000, Vec3(0.3, 0.2, dim == 3 ? 0.1 : 0.0), 0.5, m.dx);
+        for (auto& S : start.particles.stress) S = Mat3::Random();
+        for (auto& C : start.particles.C) C = Mat3::Random();
+        StepContext ctx = Context(m);
+        ctx.dt = 1e-3;
+        ctx.gravity = Vec3(0, -9.81, 0);
+        State s[2] = {start, start};
+        SparseGrid grid[2];
+        std::vector<Mat3> L[2];
+        std::vector<Vec3> force[2], remapped[2];
+        for (int k = 0; k < 2; ++k) {
+          SetWideSimd(k == 1);
+          ASSERT_EQ(WideSimd(), k == 1);
+          RebuildGrid(m, s[k].particles, grid[k]);
+          ParticleToGrid(m, ctx, s[k].particles, grid[k]);
+          force[k] = grid[k].force;
+          WallReport walls;
+          UpdateGridVelocity(m, ctx, grid[k], walls);
+          GridToParticle(m, ctx, grid[k], s[k].particles, &L[k], nullptr);
+          RemapMomentum(m, ctx, s[k].particles, grid[k]);  // MUSL: momentum only
+          remapped[k] = grid[k].momentum;
+        }
+        SCOPED_TRACE(::testing::Message() << dim << "-D, shape " << int(shape) << ", transfer "
+                                          << int(transfer));
+        EXPECT_TRUE(grid[0].mass == grid[1].mass);
+        EXPECT_TRUE(force[0] == force[1]);
+        EXPECT_TRUE(grid[0].velocity_new == grid[1].velocity_new);
+        EXPECT_TRUE(remapped[0] == remapped[1]);
+        EXPECT_TRUE(L[0] == L[1]);
+        EXPECT_TRUE(s[0].particles.v == s[1].particles.v);
+        EXPECT_TRUE(s[0].particles.C == s[1].particles.C);
+        EXPECT_TRUE(s[0].particles.x == s[1].particles.x);
+        EXPECT_FALSE(s[0].particles.v == start.particles.v);  // the step changed them
+      }
+  SetWideSimd(was);
 }
 
 }  // namespace
