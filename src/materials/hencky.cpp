@@ -51,6 +51,17 @@ void HenckyTrialStates(Real K, Real G, const Mat3& f0, const Mat3& elastic_b0, c
   TrialFromPrincipal(K, G, b1, t1);
 }
 
+void HenckyTrialStates4(Real K, Real G, const Mat3* f, const Mat3* elastic_b, HenckyTrial* t) {
+  Mat3 b[4], Q[4];
+  Vec3 principal[4];
+  for (int k = 0; k < 4; ++k) b[k] = t[k].b = TrialB(f[k], elastic_b[k]);
+  SymmetricEigen4(b, principal, Q);  // Table 3.4, step 2
+  for (int k = 0; k < 4; ++k) {
+    t[k].Q = Q[k];
+    TrialFromPrincipal(K, G, principal[k], t[k]);
+  }
+}
+
 Mat3 ExpTwice(const Mat3& eps) {
   Vec3 eps_principal;
   Mat3 Q;

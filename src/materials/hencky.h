@@ -26,6 +26,8 @@ HenckyTrial HenckyTrialState(Real K, Real G, const Mat3& f, const Mat3& elastic_
 // spectral decompositions run side by side (SymmetricEigen2).
 void HenckyTrialStates(Real K, Real G, const Mat3& f0, const Mat3& elastic_b0, const Mat3& f1,
                        const Mat3& elastic_b1, HenckyTrial& t0, HenckyTrial& t1);
+// The same for four particles (f[k], elastic_b[k] into t[k]): SymmetricEigen4.
+void HenckyTrialStates4(Real K, Real G, const Mat3* f, const Mat3* elastic_b, HenckyTrial* t);
 
 // Principal Kirchhoff stress of principal Hencky strains: tau_i = K tr(eps) + 2G (eps_i - tr/3)
 // ([C^e_d], spec §2.0, with the factor 2 of erratum 1). Inline, as the two below: they run once

@@ -13,11 +13,14 @@
 #include <cstdint>
 #include <utility>
 
+#include "core/simd.h"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-
-#include "core/simd.h"
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>  // _mm256_zeroupper (SymmetricEigen4)
+#endif
 
 namespace surge {
 namespace {
@@ -48,6 +51,23 @@ struct PairLane {
   static T Splat(Real a) { return T{a, a}; }
 };
 
+#if SURGE_HAVE_WIDE_SIMD
+// Four matrices (the AVX build, SymmetricEigen4): as PairLane with four lanes, in generic vector
+// operations only (an AVX intrinsic here could not be inlined into the default-target template
+// Decompose). Decompose<QuadLane> is inlined into SURGE_TARGET_WIDE Decompose4, where the compiler
+// emits AVX instructions for them; sqrt lane by lane (no errno in this file: -fno-math-errno).
+struct QuadLane {
+  using T = Real4;
+  typedef int64_t M __attribute__((vector_size(4 * sizeof(int64_t))));
+  static T Sqrt(T a) {
+    return T{__builtin_sqrt(a[0]), __builtin_sqrt(a[1]), __builtin_sqrt(a[2]), __builtin_sqrt(a[3])};
+  }
+  static T Abs(T a) { return T(M(a) & M{INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX}); }
+  static T Sel(M m, T a, T b) { return m ? a : b; }
+  static T Splat(Real a) { return T{a, a, a, a}; }
+};
+#endif
+
 // The symmetric entries of one or two matrices, and the result before sorting: eigenvalue l[k]
 // of the scaled, shifted matrix B = (A - m I) / s with unit eigenvector vec[k] (x, y, z).
 template <class L>
@@ -62,7 +82,7 @@ struct Lanes {
 // Smith (1961) extreme root, its eigenvector by cross products, one Jacobi rotation for the rest
 // (see the header). Requires s > 0 in every lane.
 template <class L>
-void Decompose(Lanes<L>& z) {
+[[gnu::always_inline]] inline void Decompose(Lanes<L>& z) {
   using T = typename L::T;
   const T one = L::Splat(1), zero = L::Splat(0);
   // Shift by the mean eigenvalue and scale: B = (A - m I) / s has zero trace and entries <= 1,
@@ -159,6 +179,9 @@ void Decompose(Lanes<L>& z) {
 
 void Put(Real& slot, int, Real value) { slot = value; }
 void Put(Real2& slot, int lane, Real value) { slot[lane] = value; }
+#if SURGE_HAVE_WIDE_SIMD
+void Put(Real4& slot, int lane, Real value) { slot[lane] = value; }
+#endif
 
 // Loads A's symmetric part, its shift m and scale s into lane `lane` (scalar: lane 0 only).
 template <class L>
@@ -249,6 +272,45 @@ void SymmetricEigen2(const Mat3& a0, const Mat3& a1, Vec3& values0, Mat3& vector
     Store(z.m[lane], z.s[lane], l, vec, lane == 0 ? values0 : values1,
           lane == 0 ? vectors0 : vectors1);
   }
+}
+
+#if SURGE_HAVE_WIDE_SIMD
+namespace {
+// False (nothing written) when a matrix is a multiple of I, as SymmetricEigen handles alone.
+SURGE_TARGET_WIDE bool Decompose4(const Mat3* a, Vec3* values, Mat3* vectors) {
+  Lanes<QuadLane> z;
+  for (int lane = 0; lane < 4; ++lane) {
+    Load(a[lane], z, lane);
+    if (z.s[lane] == 0) return false;
+  }
+  Decompose(z);
+  Real l[4][3], vec[4][3][3], m[4], scale[4];
+  for (int lane = 0; lane < 4; ++lane) {
+    for (int k = 0; k < 3; ++k) {
+      l[lane][k] = z.l[k][lane];
+      for (int c = 0; c < 3; ++c) vec[lane][k][c] = z.vec[k][c][lane];
+    }
+    m[lane] = z.m[lane];
+    scale[lane] = z.s[lane];
+  }
+  // Clean upper register halves before the SSE code that follows (GCC 12 leaves them dirty here,
+  // which slowed every later SSE instruction of the stress update by about half).
+  _mm256_zeroupper();
+  for (int lane = 0; lane < 4; ++lane)
+    Store(m[lane], scale[lane], l[lane], vec[lane], values[lane], vectors[lane]);
+  return true;
+}
+}  // namespace
+#endif
+
+void SymmetricEigen4(const Mat3* a, Vec3* values, Mat3* vectors) {
+#if SURGE_HAVE_WIDE_SIMD
+  bool plain = WideSimd();
+  for (int lane = 0; lane < 4; ++lane) plain = plain && !IsDiagonal(a[lane]);
+  if (plain && Decompose4(a, values, vectors)) return;
+#endif
+  SymmetricEigen2(a[0], a[1], values[0], vectors[0], values[1], vectors[1]);
+  SymmetricEigen2(a[2], a[3], values[2], vectors[2], values[3], vectors[3]);
 }
 
 }  // namespace surge

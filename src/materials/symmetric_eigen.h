@@ -25,4 +25,9 @@ void SymmetricEigen(const Mat3& a, Vec3& values, Mat3& vectors);
 void SymmetricEigen2(const Mat3& a0, const Mat3& a1, Vec3& values0, Mat3& vectors0, Vec3& values1,
                      Mat3& vectors1);
 
+// Four decompositions at once (a[0..3] into values[k], vectors[k]), each bitwise equal to
+// SymmetricEigen of its matrix: the AVX build (core/simd.h) where WideSimd(), else two
+// SymmetricEigen2.
+void SymmetricEigen4(const Mat3* a, Vec3* values, Mat3* vectors);
+
 }  // namespace surge

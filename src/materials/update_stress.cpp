@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "core/parallel.h"
+#include "core/simd.h"
 #include "materials/bingham_fluid.h"
 #include "materials/drucker_prager.h"
 #include "materials/frictional_fluid.h"
@@ -64,7 +65,8 @@ void UpdateOne(const Pm& params, Real dt, size_t p, const Mat3& L, Particles& P)
 // grad(k); with `energy` returns the sum of their stress powers P_n + P_{n+1} in k order, else 0.
 // Elastoplastic models (Hencky elasticity, b^e, Table 3.4) provide PlasticUpdate(params, f, trial,
 // J, b^e, history, sigma) in their own headers and take the trial state from here, two particles
-// at a time (HenckyTrialStates: two spectral decompositions side by side). Each particle's result
+// or four at a time (HenckyTrialStates, HenckyTrialStates4: two or four spectral decompositions
+// side by side, four in the AVX build, core/simd.h). Each particle's result
 // is bitwise what the one-particle path gives, so neither the thread count, the split into spans
 // nor the pairing changes a result.
 // With `checks`, each particle goes through checks->Test after its update.
@@ -83,11 +85,12 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
         },
         "an elastoplastic model must take its Hencky trial state from the caller");
     const Real K = params.bulk_modulus, G = params.shear_modulus;
-    for (size_t k0 = k_begin; k0 < k_end; k0 += 2) {
-      const size_t n = std::min<size_t>(2, k_end - k0);
-      size_t p[2];
-      Mat3 f[2], b[2];
-      Real before[2] = {0, 0};
+    const size_t group = WideSimd() ? 4 : 2;  // SymmetricEigen4 (AVX) or SymmetricEigen2
+    for (size_t k0 = k_begin; k0 < k_end; k0 += group) {
+      const size_t n = std::min<size_t>(group, k_end - k0);
+      size_t p[4];
+      Mat3 f[4], b[4];
+      Real before[4] = {0, 0, 0, 0};
       for (size_t i = 0; i < n; ++i) {
         p[i] = index(k0 + i);
         const Mat3& L = grad(k0 + i);
@@ -96,11 +99,16 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
         P.F[p[i]] = Mul(f[i], P.F[p[i]]);  // F_{n+1} = f F_n (2.18)
         b[i] = P.elastic_b[p[i]];  // b^e stored as its 6 components
       }
-      HenckyTrial t[2];
-      if (n == 2) {
-        HenckyTrialStates(K, G, f[0], b[0], f[1], b[1], t[0], t[1]);
+      HenckyTrial t[4];
+      if (n == 4) {
+        HenckyTrialStates4(K, G, f, b, t);
       } else {
-        t[0] = HenckyTrialState(K, G, f[0], b[0]);
+        for (size_t i = 0; i < n; i += 2) {
+          if (i + 1 < n)
+            HenckyTrialStates(K, G, f[i], b[i], f[i + 1], b[i + 1], t[i], t[i + 1]);
+          else
+            t[i] = HenckyTrialState(K, G, f[i], b[i]);
+        }
       }
       for (size_t i = 0; i < n; ++i) {
         Mat3 stress;

@@ -17,6 +17,7 @@
 #include <string>
 #include <thread>
 
+#include "core/simd.h"
 #include "scene/scene.h"
 #include "step/step.h"
 
@@ -128,6 +129,7 @@ void TimeSteps(benchmark::State& bm, LoadedScene& scene, Workspace& work, int wa
   bm.counters["allocs_per_step"] = double(g_new_calls.load() - calls0) / double(steps);
   bm.counters["alloc_bytes_per_step"] = double(g_new_bytes.load() - bytes0) / double(steps);
   bm.counters["particles"] = double(n);
+  bm.counters["wide_simd"] = WideSimd() ? 1 : 0;
   bm.counters["updates_per_s"] =
       benchmark::Counter(double(n) * double(steps), benchmark::Counter::kIsRate);
   for (int s = 0; s < kStageCount; ++s)
@@ -310,6 +312,14 @@ void BM_CoreToCoreRoundTrip(benchmark::State& state) {
   state.counters["ns_per_round_trip"] = seconds * 1e9 / (double(kTrips) * double(state.iterations()));
 }
 BENCHMARK(BM_CoreToCoreRoundTrip)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// SURGE_WIDE_SIMD=0 runs the portable builds of the kernels (core/simd.h) on an AVX machine, so
+// one binary measures both; the `wide_simd` counter says which ran.
+const bool kWideSimdFromEnv = [] {
+  const char* v = std::getenv("SURGE_WIDE_SIMD");
+  if (v && std::string(v) == "0") SetWideSimd(false);
+  return WideSimd();
+}();
 
 }  // namespace
 }  // namespace surge

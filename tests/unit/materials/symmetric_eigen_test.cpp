@@ -10,6 +10,8 @@
 #include <functional>
 #include <random>
 
+#include "core/simd.h"
+
 namespace surge {
 namespace {
 
@@ -17,6 +19,7 @@ struct Worst {
   double residual = 0, orthogonality = 0, eigenvalue = 0, log_tensor = 0;
   bool ascending = true;
   bool pair_equal = true;  // SymmetricEigen2 bitwise equal to SymmetricEigen in both lanes
+  bool quad_equal = true;  // SymmetricEigen4 too, in all four lanes (AVX build where WideSimd())
 };
 
 // Q diag(ln l) Q^T.
@@ -35,6 +38,8 @@ Worst Check(int count, const std::function<Mat3(std::mt19937&)>& make) {
   Worst w;
   Mat3 previous = Mat3::Identity(), previous_q = Mat3::Identity();
   Vec3 previous_l = Vec3::Ones();
+  Mat3 recent[4], recent_q[4];
+  Vec3 recent_l[4];
   for (int k = 0; k < count; ++k) {
     const Mat3 a = Sym(make(g));
     Vec3 l;
@@ -45,6 +50,15 @@ Worst Check(int count, const std::function<Mat3(std::mt19937&)>& make) {
     Mat3 q0, q1;
     SymmetricEigen2(a, previous, l0, q0, l1, q1);
     w.pair_equal = w.pair_equal && l0 == l && q0 == q && l1 == previous_l && q1 == previous_q;
+    // The quad form, with the three previous matrices in the other lanes.
+    recent[k % 4] = a, recent_l[k % 4] = l, recent_q[k % 4] = q;
+    if (k >= 3) {
+      Vec3 l4[4];
+      Mat3 q4[4];
+      SymmetricEigen4(recent, l4, q4);
+      for (int i = 0; i < 4; ++i)
+        w.quad_equal = w.quad_equal && l4[i] == recent_l[i] && q4[i] == recent_q[i];
+    }
     previous = a, previous_l = l, previous_q = q;
     const double norm = a.norm();
     w.residual = std::max(w.residual, (a * q - q * l.asDiagonal()).norm() / norm);
@@ -71,6 +85,7 @@ void ExpectAccurate(const Worst& w) {
   EXPECT_LT(w.log_tensor, 1e-14);
   EXPECT_TRUE(w.ascending);
   EXPECT_TRUE(w.pair_equal);
+  EXPECT_TRUE(w.quad_equal);
 }
 
 std::normal_distribution<double> Normal(double sd) { return std::normal_distribution<double>(0, sd); }
@@ -155,6 +170,32 @@ TEST(SymmetricEigen, PairEqualsSingleOnSmallIntegerMatrices) {
     ++checked;
   }
   EXPECT_EQ(checked, 20000);
+}
+
+// SymmetricEigen4 on the same structured inputs, with the AVX build on (where the CPU has AVX)
+// and off: every lane bitwise the one-matrix result, diagonal and isotropic lanes included.
+TEST(SymmetricEigen, QuadEqualsSingleOnSmallIntegerMatrices) {
+  const bool was = WideSimd();
+  for (bool wide : {true, false}) {
+    SetWideSimd(wide);
+    std::mt19937 g(11);
+    std::uniform_int_distribution<int> n(-2, 2);
+    for (int k = 0; k < 10000; ++k) {
+      Mat3 a[4], q[4], r[4];
+      Vec3 l[4], p[4];
+      for (Mat3& m : a) {
+        for (int i = 0; i < 3; ++i)
+          for (int j = i; j < 3; ++j) m(i, j) = m(j, i) = n(g);
+      }
+      for (int i = 0; i < 4; ++i) SymmetricEigen(a[i], l[i], q[i]);
+      SymmetricEigen4(a, p, r);
+      for (int i = 0; i < 4; ++i) {
+        ASSERT_EQ(p[i], l[i]) << a[i] << (wide ? " (wide)" : "");
+        ASSERT_EQ(r[i], q[i]) << a[i] << (wide ? " (wide)" : "");
+      }
+    }
+  }
+  SetWideSimd(was);
 }
 
 }  // namespace
