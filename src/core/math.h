@@ -46,6 +46,13 @@ inline Mat3 Increment(Real dt, const Mat3& L) {
          a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
 }
 
+// det(a) of a dim-D state: in 2-D (plane strain) of the in-plane block only, in 3-D Det3.
+template <int kDim>
+[[gnu::always_inline]] inline Real DetOfDim(const Mat3& a) {
+  if constexpr (kDim == 2) return a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
+  return Det3(a);
+}
+
 // Symmetric part of a 3x3 matrix.
 inline Mat3 Sym(const Mat3& a) { return 0.5 * (a + a.transpose()); }
 

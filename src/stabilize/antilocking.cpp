@@ -32,22 +32,16 @@ struct Accum {
   Real w, wq;  // sum w m, sum w m theta
 };
 
-// Determinant; in 2-D (plane strain) of the in-plane block only.
-template <int kDim>
-[[gnu::always_inline]] inline Real Det(const Mat3& a) {
-  if constexpr (kDim == 2) return a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
-  return Det3(a);
-}
-
 // Trial volumetric strain theta_p = tr(1/2 log b^tr) = ln det f + ln J_n (seed (4.36)-(4.38) and
 // §3.5): J_n = det F_n for elastic solids and fluids, whose state is F; J^e_n = sqrt(det b^e_n)
 // for the elastoplastic models, whose trial elastic strain is approximated (seed §4.4.5).
 // With the increment option, theta_p = ln det f: only the step's volume change is projected.
 template <int kDim>
 Real TrialTheta(const Mat3& f, const Particles& P, size_t p, const Mode& mode) {
-  if (mode.increment) return std::log(Det<kDim>(f));
-  const Real jn = mode.elastoplastic ? std::sqrt(Det<kDim>(P.elastic_b[p])) : Det<kDim>(P.F[p]);
-  return std::log(Det<kDim>(f) * jn);
+  if (mode.increment) return std::log(DetOfDim<kDim>(f));
+  const Real jn =
+      mode.elastoplastic ? std::sqrt(DetOfDim<kDim>(P.elastic_b[p])) : DetOfDim<kDim>(P.F[p]);
+  return std::log(DetOfDim<kDim>(f) * jn);
 }
 
 // Seed §3.5 (AS1 as a hydrostatic shift): each principal trial log strain moves by

@@ -17,13 +17,6 @@ namespace {
 
 using K = QuadraticBsplineKernel;
 
-// Determinant; in 2-D (plane strain) of the in-plane block only.
-template <int kDim>
-[[gnu::always_inline]] inline Real Det(const Mat3& a) {
-  if constexpr (kDim == 2) return a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
-  return Det3(a);
-}
-
 // Whether particle p belongs to a material that shifts (the groups are few: a linear scan).
 bool Shifts(const Model& model, const std::vector<MaterialGroup>& groups, size_t p) {
   for (const MaterialGroup& g : groups)
@@ -42,7 +35,7 @@ void ScatterVolume(const StepContext& ctx, const Particles& P, const SparseGrid&
   if (grid.block_begin[blk] == grid.block_begin[blk + 1]) return;
   for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
     const uint32_t p = grid.sorted[k];
-    const Real v = Det<kDim>(P.F[p]) * P.volume0[p];  // V_p = J_p V0_p
+    const Real v = DetOfDim<kDim>(P.F[p]) * P.volume0[p];  // V_p = J_p V0_p
     Stencil<kDim, K> st;
     st.Compute(P.x[p], ctx.inv_dx, 0);
     const Vec3i lb = st.base - origin;
@@ -89,7 +82,7 @@ void GatherGradient(const Model& model, const StepContext& ctx,
           const Real e = excess[size_t(g)];
           if (e != 0) grad += e * st.Gradient(i, j, c);
         }
-    shift[p] = 2 * Det<kDim>(P.F[p]) * P.volume0[p] * grad;  // g_p
+    shift[p] = 2 * DetOfDim<kDim>(P.F[p]) * P.volume0[p] * grad;  // g_p
   }
 }
 
