@@ -59,14 +59,21 @@ struct PairLane {
 struct QuadLane {
   using T = Real4;
   typedef int64_t M __attribute__((vector_size(4 * sizeof(int64_t))));
-  static T Sqrt(T a) {
+  [[gnu::always_inline]] static T Sqrt(T a) {
     return T{__builtin_sqrt(a[0]), __builtin_sqrt(a[1]), __builtin_sqrt(a[2]), __builtin_sqrt(a[3])};
   }
-  static T Abs(T a) { return T(M(a) & M{INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX}); }
-  static T Sel(M m, T a, T b) { return m ? a : b; }
-  static T Splat(Real a) { return T{a, a, a, a}; }
+  [[gnu::always_inline]] static T Abs(T a) {
+    return T(M(a) & M{INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX});
+  }
+  [[gnu::always_inline]] static T Sel(M m, T a, T b) { return m ? a : b; }
+  [[gnu::always_inline]] static T Splat(Real a) { return T{a, a, a, a}; }
 };
 #endif
+
+// The lane helpers of Decompose are always inlined: a Real4 passed to or returned from a call
+// between the AVX function and a default-target helper would change the ABI (clang at -O1 kept
+// such calls and got wrong lanes).
+#define SURGE_LANE_INLINE __attribute__((always_inline))
 
 // The symmetric entries of one or two matrices, and the result before sorting: eigenvalue l[k]
 // of the scaled, shifted matrix B = (A - m I) / s with unit eigenvector vec[k] (x, y, z).
@@ -119,12 +126,12 @@ template <class L>
 
   // Its eigenvector: B - l1 I has rank 2, so the largest cross product of two rows spans its kernel.
   const T r0[3] = {b00 - l1, b01, b02}, r1[3] = {b01, b11 - l1, b12}, r2[3] = {b02, b12, b22 - l1};
-  const auto cross = [](const T* a, const T* b, T* c) {
+  const auto cross = [](const T* a, const T* b, T* c) SURGE_LANE_INLINE {
     c[0] = a[1] * b[2] - a[2] * b[1];
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
   };
-  const auto norm2 = [](const T* a) { return a[0] * a[0] + a[1] * a[1] + a[2] * a[2]; };
+  const auto norm2 = [](const T* a) SURGE_LANE_INLINE { return a[0] * a[0] + a[1] * a[1] + a[2] * a[2]; };
   T v[3], c02[3], c12[3];
   cross(r0, r1, v);
   cross(r0, r2, c02);
@@ -151,12 +158,12 @@ template <class L>
 
   // B restricted to span(u, t) = [[au, e], [e, at]], diagonalised by one Jacobi rotation
   // (Golub & Van Loan Alg. 8.5.1: tan = sgn(theta) / (|theta| + sqrt(1 + theta^2))).
-  const auto apply_b = [&](const T* w, T* out) {
+  const auto apply_b = [&](const T* w, T* out) SURGE_LANE_INLINE {
     out[0] = b00 * w[0] + b01 * w[1] + b02 * w[2];
     out[1] = b01 * w[0] + b11 * w[1] + b12 * w[2];
     out[2] = b02 * w[0] + b12 * w[1] + b22 * w[2];
   };
-  const auto dot = [](const T* a, const T* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  const auto dot = [](const T* a, const T* b) SURGE_LANE_INLINE { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
   T bu[3], bt[3];
   apply_b(u, bu);
   apply_b(t, bt);
@@ -294,8 +301,11 @@ SURGE_TARGET_WIDE bool Decompose4(const Mat3* a, Vec3* values, Mat3* vectors) {
     scale[lane] = z.s[lane];
   }
   // Clean upper register halves before the SSE code that follows (GCC 12 leaves them dirty here,
-  // which slowed every later SSE instruction of the stress update by about half).
+  // which slowed every later SSE instruction of the stress update by about half). Clang inserts
+  // vzeroupper itself.
+#if !defined(__clang__)
   _mm256_zeroupper();
+#endif
   for (int lane = 0; lane < 4; ++lane)
     Store(m[lane], scale[lane], l[lane], vec[lane], values[lane], vectors[lane]);
   return true;
