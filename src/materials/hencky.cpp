@@ -25,7 +25,8 @@ namespace {
 }
 
 // Steps 3-4 of Table 3.4 from the decomposition of b^e_tr (step 2).
-[[gnu::always_inline]] inline void TrialFromPrincipal(Real K, Real G, const Vec3& b_principal, HenckyTrial& t) {
+[[gnu::always_inline]] inline void TrialFromPrincipal(Real K, Real G, const Vec3& b_principal,
+                                                      HenckyTrial& t) {
   t.eps = 0.5 * b_principal.array().log();  // (3.34), erratum 2
   t.tau = HenckyStress(K, G, t.eps);
 }

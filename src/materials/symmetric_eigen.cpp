@@ -60,7 +60,8 @@ struct QuadLane {
   using T = Real4;
   typedef int64_t M __attribute__((vector_size(4 * sizeof(int64_t))));
   [[gnu::always_inline]] static T Sqrt(T a) {
-    return T{__builtin_sqrt(a[0]), __builtin_sqrt(a[1]), __builtin_sqrt(a[2]), __builtin_sqrt(a[3])};
+    return T{__builtin_sqrt(a[0]), __builtin_sqrt(a[1]), __builtin_sqrt(a[2]),
+             __builtin_sqrt(a[3])};
   }
   [[gnu::always_inline]] static T Abs(T a) {
     return T(M(a) & M{INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX});
@@ -131,7 +132,9 @@ template <class L>
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
   };
-  const auto norm2 = [](const T* a) SURGE_LANE_INLINE { return a[0] * a[0] + a[1] * a[1] + a[2] * a[2]; };
+  const auto norm2 = [](const T* a) SURGE_LANE_INLINE {
+    return a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+  };
   T v[3], c02[3], c12[3];
   cross(r0, r1, v);
   cross(r0, r2, c02);
@@ -163,7 +166,9 @@ template <class L>
     out[1] = b01 * w[0] + b11 * w[1] + b12 * w[2];
     out[2] = b02 * w[0] + b12 * w[1] + b22 * w[2];
   };
-  const auto dot = [](const T* a, const T* b) SURGE_LANE_INLINE { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  const auto dot = [](const T* a, const T* b) SURGE_LANE_INLINE {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  };
   T bu[3], bt[3];
   apply_b(u, bu);
   apply_b(t, bt);
