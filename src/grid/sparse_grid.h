@@ -110,9 +110,9 @@ struct SparseGrid {
     Vec3i mirror;         // node coordinate of its mirror image inside the domain
   };
   std::vector<GhostNode> ghosts;
-  // Wall contact (MarkWallContacts): per active wall (ActiveWalls order), a bitmap over the node
-  // columns normal to it, 1 where a particle touches the wall there this step. Empty `touched`
-  // (the gap test off): every wall acts on every node with mass on or beyond it.
+  // Wall contact (RebuildGrid, WallTouchMarker): per active wall (ActiveWalls order), a bitmap
+  // over the node columns normal to it, 1 where a particle touches the wall there this step.
+  // Empty `touched` (the gap test off): every wall acts on every node with mass on or beyond it.
   struct WallTouch {
     int axis = 0;          // the wall's normal axis
     Vec3i lo = Vec3i::Zero();  // lowest node index of the map along the two tangential axes
@@ -120,7 +120,6 @@ struct SparseGrid {
     std::vector<uint8_t> touched;  // [i1 * n2 + i2]
   };
   std::array<WallTouch, 6> wall_touch;
-  std::array<std::vector<uint32_t>, 64> touch_scratch;  // per chunk: p * 8 + wall (MarkWallContacts)
   std::vector<Vec3i> ghost_mirror_block;   // [2 g]: block of the mirror node, [2 g + 1]: of the
   std::vector<int32_t> ghost_mirror_index; //   node on the wall plane below the ghost (if any)
 

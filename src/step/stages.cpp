@@ -43,7 +43,6 @@ void ParticleToGridStage(const Model& m, const StepContext& c, State& s, Workspa
 
 void GridUpdateStage(const Model& m, const StepContext& c, State& s, Workspace& w,
                      StepReport& r) {
-  MarkWallContacts(m, c, s.particles, w.grid);
   UpdateGridVelocity(m, c, w.grid, r.walls);
   s.wall_work += r.walls.work;
 }

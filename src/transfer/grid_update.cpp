@@ -4,6 +4,7 @@
 // R = -m_i (v_c - v_u) / dt, summed per face.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -21,111 +22,78 @@ constexpr int kFaceSums = 7;
 constexpr int kWork = kFaceSums * kFaceCount, kMaxNodal = kWork + 1, kMaxElevation = kWork + 2;
 static_assert(kMaxElevation + 1 == std::tuple_size_v<SparseGrid::WallPartial>);
 
-void MarkWallContacts(const Model& model, const StepContext& ctx, const Particles& P,
-                      SparseGrid& grid) {
-  WallPlane walls[kFaceCount];
-  const int wall_count = ActiveWalls(model, walls);
+WallTouchMarker::WallTouchMarker(const Model& model, Real dx, SparseGrid& grid)
+    : dim_(model.dim), inv_dx_(1.0 / dx), gimp_(model.shape == ShapeFunction::kGimp), grid_(&grid) {
   for (auto& t : grid.wall_touch) t.touched.clear();
-  if (!model.wall_gap_test || wall_count == 0) return;
-  // Reach of a particle's kernel along the wall [m]: where its stencil has non-zero weights.
-  const Real reach = ctx.dx * (model.shape == ShapeFunction::kLinear                ? 1.0
-                               : model.shape == ShapeFunction::kQuadraticBspline ? 1.5
-                               : model.shape == ShapeFunction::kCubicBspline     ? 2.0
-                                                                                 : 1.0);
-  for (int k = 0; k < wall_count; ++k) {
+  if (!model.wall_gap_test) return;
+  count_ = ActiveWalls(model, walls_);
+  c_touch_ = model.dim == 3 ? 0.421875 : 0.5625;  // 0.75^dim
+  for (int a = 0; a < 3; ++a) {
+    near_.lo[a] = -std::numeric_limits<Real>::infinity();
+    near_.hi[a] = std::numeric_limits<Real>::infinity();
+  }
+  for (int k = 0; k < count_; ++k)
+    (walls_[k].sign > 0 ? near_.lo : near_.hi)[walls_[k].axis] = walls_[k].level;
+  near_.c_touch = c_touch_;
+  near_.cube = dim_ == 3;
+  reach_ = dx * (model.shape == ShapeFunction::kLinear             ? 1.0
+                 : model.shape == ShapeFunction::kQuadraticBspline ? 1.5
+                 : model.shape == ShapeFunction::kCubicBspline     ? 2.0
+                                                                   : 1.0);
+  for (int k = 0; k < count_; ++k) {
     SparseGrid::WallTouch& t = grid.wall_touch[k];
-    t.axis = walls[k].axis;
+    t.axis = walls_[k].axis;
     for (int j = 1; j <= 2; ++j) {
       const int a = (t.axis + j) % 3;
       const bool used = a < model.dim;
       // node columns over the domain plus 3 cells either side (stencils reach past it)
-      const int lo = used ? int(std::floor(model.domain_min[a] * ctx.inv_dx)) - 3 : 0;
-      const int hi = used ? int(std::ceil(model.domain_max[a] * ctx.inv_dx)) + 3 : 0;
+      const int lo = used ? int(std::floor(model.domain_min[a] * inv_dx_)) - 3 : 0;
+      const int hi = used ? int(std::ceil(model.domain_max[a] * inv_dx_)) + 3 : 0;
       t.lo[a] = lo;
       (j == 1 ? t.n1 : t.n2) = hi - lo + 1;
     }
     t.touched.assign(size_t(t.n1) * size_t(t.n2), 0);
   }
-  // Touching: d <= 1.5 half, half = V0^(1/dim) / 2, tested without the root (cbrt was about 1 %
-  // of a step): d <= 0, or d^dim <= 0.75^dim V0.
-  const Real c_touch = model.dim == 3 ? 0.421875 : 0.5625;
-  const auto touches = [&](size_t p, int k) {
-    const Real d = walls[k].sign * (P.x[p][walls[k].axis] - walls[k].level);
-    return d <= 0 || (model.dim == 3 ? d * d * d : d * d) <= c_touch * P.volume0[p];
-  };
-  // Broad phase by blocks: a particle owned by block b (binned this step, RebuildGrid) has its
-  // stencil base node in the block, K::Base(x / dx) in [o, o + kBlockDim) with o the block origin,
-  // and Base(u) in (u - 2, u] for every kernel, so x / dx lies in [o, o + kBlockDim + 2) along each
-  // axis (one more cell either side below for the rounding of x / dx). No particle of a block
-  // farther than the largest touch distance, 0.75 V0max^(1/dim) (plus a rounding margin), from
-  // every wall can touch one.
-  std::array<Real, kReductionChunks> v0_part{};
-  ParallelChunks(P.size(), [&](size_t chunk, size_t b, size_t e) {
-    Real v = 0;
-    for (size_t p = b; p < e; ++p) v = std::max(v, P.volume0[p]);
-    v0_part[chunk] = v;
-  });
-  const Real v0_max = *std::max_element(v0_part.begin(), v0_part.end());
-  const Real touch_max =
-      0.75 * (model.dim == 3 ? std::cbrt(v0_max) : std::sqrt(v0_max)) * (1 + 1e-9) + 1e-12 * ctx.dx;
-  // The walls near block blk, one bit each: only those are tested for its particles (a block
-  // of a column standing in a corner is near one or two of the five walls).
-  const auto walls_near = [&](size_t blk) {
-    unsigned near = 0;
-    for (int k = 0; k < wall_count; ++k) {
-      const int a = walls[k].axis;
-      const Real lo = (grid.block_origin[blk][a] - 1) * ctx.dx, hi = lo + (kBlockDim + 4) * ctx.dx;
-      const Real d_min = walls[k].sign > 0 ? lo - walls[k].level : walls[k].level - hi;
-      if (d_min <= touch_max) near |= 1u << k;
+}
+
+void WallTouchMarker::MarkTouched(const Vec3& x, Real volume0, Recent& recent) const {
+  for (int k = 0; k < count_; ++k) {
+    const WallPlane& w = walls_[k];
+    const Real d = w.sign * (x[w.axis] - w.level);
+    if (d <= 0 || (dim_ == 3 ? d * d * d : d * d) <= c_touch_ * volume0)
+      MarkColumns(x, volume0, k, recent.range[k]);
+  }
+}
+
+void WallTouchMarker::MarkColumns(const Vec3& x, Real volume0, int k, int* recent) const {
+  SparseGrid::WallTouch& t = grid_->wall_touch[k];
+  // GIMP: the particle's half width adds to the reach (only there: the root is not free).
+  const Real r = !gimp_ ? reach_
+                        : reach_ + 0.5 * (dim_ == 3 ? std::cbrt(volume0) : std::sqrt(volume0));
+  int range[2][2];  // node index range along the two tangential axes
+  for (int j = 1; j <= 2; ++j) {
+    const int a = (t.axis + j) % 3;
+    if (a >= dim_) {
+      range[j - 1][0] = range[j - 1][1] = 0;
+      continue;
     }
-    return near;
-  };
-  // Find the touching particles in parallel (per chunk of blocks, in block and particle order),
-  // mark serially: the marks are a set, so the result is the same for any thread count.
-  // Chunk c takes the blocks of particles [n c / C, n (c + 1) / C), so the threads get equal
-  // shares of particles and keep the ones they own (transfer/owned_loops.h).
-  ParallelChunks(grid.block_count(), [&](size_t chunk, size_t, size_t) {
-    const size_t b_begin = OwnedBlockBegin(grid, chunk, kReductionChunks);
-    const size_t b_end = OwnedBlockBegin(grid, chunk + 1, kReductionChunks);
-    std::vector<uint32_t>& out = grid.touch_scratch[chunk];
-    out.clear();
-    for (size_t blk = b_begin; blk < b_end; ++blk) {
-      if (grid.block_begin[blk] == grid.block_begin[blk + 1]) continue;
-      const unsigned near = walls_near(blk);
-      if (near == 0) continue;
-      for (uint32_t s = grid.block_begin[blk]; s < grid.block_begin[blk + 1]; ++s) {
-        const size_t p = grid.sorted[s];
-        for (int k = 0; k < wall_count; ++k)
-          if ((near >> k & 1u) && touches(p, k)) out.push_back(uint32_t(p) * 8 + uint32_t(k));
-      }
-    }
-  });
-  for (size_t c = 0; c < grid.touch_scratch.size(); ++c)
-    for (const uint32_t entry : grid.touch_scratch[c]) {
-      const size_t p = entry / 8;
-      const int k = int(entry % 8);
-      SparseGrid::WallTouch& t = grid.wall_touch[k];
-      // GIMP: the particle's half width adds to the reach (only there: the root is not free).
-      const Real r = model.shape != ShapeFunction::kGimp
-                         ? reach
-                         : reach + 0.5 * (model.dim == 3 ? std::cbrt(P.volume0[p])
-                                                         : std::sqrt(P.volume0[p]));
-      int range[2][2];  // node index range along the two tangential axes
-      for (int j = 1; j <= 2; ++j) {
-        const int a = (t.axis + j) % 3;
-        if (a >= model.dim) {
-          range[j - 1][0] = range[j - 1][1] = 0;
-          continue;
-        }
-        // nodes with |x_i - x_p| < r (a weight exactly at the edge of the support is zero)
-        range[j - 1][0] = int(std::floor((P.x[p][a] - r) * ctx.inv_dx)) + 1;
-        range[j - 1][1] = int(std::ceil((P.x[p][a] + r) * ctx.inv_dx)) - 1;
-      }
-      const int a1 = (t.axis + 1) % 3, a2 = (t.axis + 2) % 3;
-      for (int i1 = std::max(range[0][0] - t.lo[a1], 0); i1 <= std::min(range[0][1] - t.lo[a1], t.n1 - 1); ++i1)
-        for (int i2 = std::max(range[1][0] - t.lo[a2], 0); i2 <= std::min(range[1][1] - t.lo[a2], t.n2 - 1); ++i2)
-          t.touched[size_t(i1) * t.n2 + i2] = 1;
-    }
+    // nodes with |x_i - x_p| < r (a weight exactly at the edge of the support is zero)
+    range[j - 1][0] = int(std::floor((x[a] - r) * inv_dx_)) + 1;
+    range[j - 1][1] = int(std::ceil((x[a] + r) * inv_dx_)) - 1;
+  }
+  if (range[0][0] == recent[0] && range[0][1] == recent[1] && range[1][0] == recent[2] &&
+      range[1][1] == recent[3])
+    return;  // marked just before
+  recent[0] = range[0][0];
+  recent[1] = range[0][1];
+  recent[2] = range[1][0];
+  recent[3] = range[1][1];
+  const int a1 = (t.axis + 1) % 3, a2 = (t.axis + 2) % 3;
+  for (int i1 = std::max(range[0][0] - t.lo[a1], 0); i1 <= std::min(range[0][1] - t.lo[a1], t.n1 - 1); ++i1)
+    for (int i2 = std::max(range[1][0] - t.lo[a2], 0); i2 <= std::min(range[1][1] - t.lo[a2], t.n2 - 1); ++i2)
+      if (std::atomic_ref<uint8_t> mark(t.touched[size_t(i1) * t.n2 + i2]);
+          mark.load(std::memory_order_relaxed) == 0)  // a line both threads mark stays shared
+        mark.store(1, std::memory_order_relaxed);
 }
 
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,

@@ -6,6 +6,7 @@
 #include "transfer/dispatch.h"
 #include "transfer/owned_loops.h"
 #include "transfer/transfer.h"
+#include "transfer/walls.h"
 
 namespace surge {
 namespace {
@@ -27,8 +28,10 @@ Vec3i OwnerBlock(const Vec3& x, Real inv_dx, uint8_t& mask) {
 
 // Pass 1: owner block and crossing mask of every particle; per-chunk deduplicated requests. Each
 // particle's particle_block holds, for now, the index of its request within its chunk's list.
+// The same pass marks the walls the particles touch (the gap test, WallTouchMarker).
 template <int kDim, class K>
-void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) {
+void ComputeRequests(const Particles& particles, Real inv_dx, const WallTouchMarker& walls,
+                     SparseGrid& grid) {
   const size_t n = particles.size();
   grid.chunk_requests.resize(kReductionChunks);
   grid.particle_block.resize(n);
@@ -42,6 +45,9 @@ void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) 
     bool used[kCache] = {};
     BlockRequest last;
     int32_t last_index = -1;
+    WallTouchMarker::Recent recent;
+    const WallTouchMarker::Near near = walls.near();  // a local copy: kept in registers
+    const bool mark = walls.active();
     for (size_t p = begin; p < end; ++p) {
       uint8_t mask = 0;
       const Vec3i block = OwnerBlock<kDim, K>(particles.x[p], inv_dx, mask);
@@ -59,6 +65,8 @@ void ComputeRequests(const Particles& particles, Real inv_dx, SparseGrid& grid) 
         }
       }
       grid.particle_block[p] = last_index;
+      if (mark && near.MayTouch(particles.x[p], particles.volume0[p]))
+        walls.MarkTouched(particles.x[p], particles.volume0[p], recent);
     }
   });
   grid.requests.clear();
@@ -119,8 +127,9 @@ void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& gri
   const Real inv_dx = 1.0 / model.dx;
   grid.SetDimension(model.dim);  // 2-D blocks hold only their z = 0 node plane
   grid.keep_reaction = !model.sensors.empty();  // the nodal reaction is read by sensors only
+  const WallTouchMarker walls(model, model.dx, grid);  // clears the maps; marks in pass 1
   DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
-    ComputeRequests<kDim, K>(particles, inv_dx, grid);
+    ComputeRequests<kDim, K>(particles, inv_dx, walls, grid);
   });
   BuildTopology(grid.requests, grid);
 

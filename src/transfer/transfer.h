@@ -18,6 +18,14 @@ namespace surge {
 // Activates the blocks under every particle's stencil, numbers them, builds the neighbour and
 // colour tables, bins particles by owner block (stable in particle index) and zeroes the node
 // fields. Reads x. Writes grid topology, binning and node arrays.
+// It also runs the gap test at the domain walls (docs/walls.md, "Stand-off"; WallTouchMarker in
+// walls.h): for each active wall it marks the node columns normal to it in which a particle
+// touches the wall, i.e. lies within 1.5 of its half-size r_p = V0^(1/d) / 2 of the plane (a
+// particle seeded against a wall sits at r_p); the columns marked are those of the nodes its
+// kernel reaches along the wall. ApplyWalls then acts only in marked columns, so a body that
+// moves onto a wall is stopped when it reaches it, not when its particles reach the wall nodes'
+// support (about one cell early). Writes grid.wall_touch; with Model::wall_gap_test off, clears
+// the maps (every wall acts everywhere).
 void RebuildGrid(const Model& model, const Particles& particles, SparseGrid& grid);
 
 // Recomputes block_begin and sorted from grid.particle_block (stable counting sort).
@@ -47,16 +55,6 @@ struct WallReport {
 // walls' share; sensors only), report.
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report);
-
-// Gap test at domain walls (docs/walls.md, "Stand-off"): marks, for each active wall, the node
-// columns normal to it in which a particle touches the wall, i.e. lies within 1.5 of its
-// half-size r_p = V0^(1/d) / 2 of the plane (a particle seeded against a wall sits at r_p); the
-// columns marked are those of the nodes its kernel reaches along the wall. ApplyWalls then acts
-// only in marked columns, so a body that moves onto a wall is stopped when it reaches it, not
-// when its particles reach the wall nodes' support (about one cell early). Reads x at t_n; writes
-// grid.wall_touch. With Model::wall_gap_test off, clears the maps (every wall acts everywhere).
-void MarkWallContacts(const Model& model, const StepContext& ctx, const Particles& particles,
-                      SparseGrid& grid);
 
 // Mirrored ghost nodes at domain walls (docs/walls.md): a node with mass beyond a wall (outside
 // the domain, not on the wall plane) takes minus the normal velocity v_{n+1} of its mirror image

@@ -1,7 +1,9 @@
 // Domain walls as node constraints (seed Planar / Fixed nodes, spec seed-algorithms.md §5.3),
 // shared by the grid update and the per-body velocity fields (body_contact.cpp).
 #pragma once
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/model.h"
 #include "grid/sparse_grid.h"
@@ -30,7 +32,61 @@ inline int ActiveWalls(const Model& model, WallPlane* out) {
   return count;
 }
 
-// Whether the material touches active wall k in the node column of `node` (MarkWallContacts);
+// The gap test's marking (docs/walls.md "Stand-off"): a particle touches wall k when its
+// distance d to the plane is at most 1.5 of its half-size V0^(1/dim) / 2, tested without the
+// root (a cbrt was about 1 % of a step): d <= 0, or d^dim <= 0.75^dim V0. It then marks the node
+// columns along the wall that its kernel reaches. The constructor sizes and
+// clears grid.wall_touch (serial; the maps are small); Mark may run on any thread: a mark is a
+// relaxed store of 1, so the maps are the same set for any thread count and particle order.
+// RebuildGrid marks in its pass over the particles (no pass of its own, no broad phase).
+class WallTouchMarker {
+ public:
+  WallTouchMarker(const Model& model, Real dx, SparseGrid& grid);
+  // Whether Mark has anything to do: the gap test is on and a wall is active.
+  bool active() const { return count_ > 0; }
+  // The node ranges last marked per wall (by one thread's run of particles): neighbouring
+  // particles mostly mark the same columns, which are then skipped.
+  struct Recent {
+    int range[kFaceCount][4];
+    Recent() {
+      for (auto& r : range) r[0] = r[1] = r[2] = r[3] = std::numeric_limits<int>::min();
+    }
+  };
+  // The nearest-wall reject: most particles touch no wall, and are rejected on their distance
+  // to the nearest one, without a loop (d^dim is monotone in d, so no wall passes the test when
+  // the nearest fails it). A value type, so that a particle loop can keep it in registers.
+  struct Near {
+    Real lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the active walls' levels per axis; -inf / +inf
+    Real c_touch = 0;                          // where there is none
+    bool cube = true;                          // 3-D: d^3
+    bool MayTouch(const Vec3& x, Real volume0) const {
+      const Real d = std::min(std::min(std::min(x.x() - lo[0], hi[0] - x.x()),
+                                       std::min(x.y() - lo[1], hi[1] - x.y())),
+                              std::min(x.z() - lo[2], hi[2] - x.z()));
+      return !(d > 0 && (cube ? d * d * d : d * d) > c_touch * volume0);
+    }
+  };
+  const Near& near() const { return near_; }
+  // Tests x against every wall and marks the columns of those it touches.
+  void MarkTouched(const Vec3& x, Real volume0, Recent& recent) const;
+  void Mark(const Vec3& x, Real volume0, Recent& recent) const {
+    if (near_.MayTouch(x, volume0)) MarkTouched(x, volume0, recent);
+  }
+
+ private:
+  void MarkColumns(const Vec3& x, Real volume0, int k, int* recent) const;
+  WallPlane walls_[kFaceCount];
+  Near near_;
+  int count_ = 0;
+  int dim_ = 3;
+  Real c_touch_ = 0;
+  Real reach_ = 0;  // kernel reach along the wall [m]: where the stencil has non-zero weights
+  Real inv_dx_ = 0;
+  bool gimp_ = false;
+  SparseGrid* grid_ = nullptr;
+};
+
+// Whether the material touches active wall k in the node column of `node` (WallTouchMarker);
 // true when the gap test is off.
 inline bool WallTouched(const SparseGrid& grid, int k, const Vec3i& node) {
   const SparseGrid::WallTouch& t = grid.wall_touch[k];
