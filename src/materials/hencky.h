@@ -87,7 +87,14 @@ inline void HenckyFinish(const HenckyTrial& t, Real K, Real G, const Vec3& tau, 
     const Vec3 eps_e = HenckyStrain(K, G, tau);
     elastic_b = FromPrincipal(t.Q, (2.0 * eps_e).array().exp().matrix());  // Table 3.4, 5(c)
   }
-  stress = FromPrincipal(t.Q, tau) / J;  // 5(d), (3.37)
+  // 5(d), (3.37): sigma = (sum tau_i m^(i)) / J, its 6 distinct entries divided once each (the
+  // matrix is symmetric, so this is bitwise FromPrincipal(Q, tau) / J with 6 divisions, not 9).
+  const Mat3 m = FromPrincipal(t.Q, tau);
+  const Real s00 = m(0, 0) / J, s01 = m(0, 1) / J, s02 = m(0, 2) / J;
+  const Real s11 = m(1, 1) / J, s12 = m(1, 2) / J, s22 = m(2, 2) / J;
+  stress << s00, s01, s02,  //
+      s01, s11, s12,        //
+      s02, s12, s22;
 }
 
 }  // namespace surge
