@@ -212,9 +212,9 @@ Vec3 UpDirection(const Model& model) {
 // Gap test: for the stencil nodes of every particle within 2 h of obstacle `ob`, the smallest
 // gap between such a particle and the surface, max(d - 1.5 r, 0) (d its signed distance,
 // r = V0^(1/d) / 2 its half-size; it touches, gap 0, within 1.5 r, the domain walls' touch test,
-// WallTouchMarker in transfer/walls.h), in scratch.gap; +inf where no particle is that near. Only the
-// candidate blocks of the broad phase (scratch.blocks) are written and read. A minimum is the
-// same in any order: the result does not depend on the thread count.
+// WallTouchMarker in transfer/walls.h), in scratch.gap; +inf where no particle is that near.
+// Only the candidate blocks of the broad phase (scratch.blocks) are written and read. A minimum
+// is the same in any order: the result does not depend on the thread count.
 void ObstacleGaps(const Model& model, const StepContext& ctx, const Obstacle& ob,
                   const ObstaclePose& pose, const SparseGrid& grid, const Particles& P,
                   ContactScratch& scratch) {

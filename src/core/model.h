@@ -171,9 +171,10 @@ struct Model {
   // domain.ghost_nodes: mirror, the default, or mirror_velocity); `constrain`: each ghost node is
   // constrained like a node on the wall (the normal inflow removed).
   GhostNodes ghost_nodes = GhostNodes::kMirror;
-  // Gap test at domain walls (RebuildGrid, WallTouchMarker; scene key domain.gap_test): a wall acts at a node
-  // only where a particle touches the wall in that node's column (its centre within 1.5 of its
-  // half-size of the plane); false: wherever a node on or beyond the wall has mass.
+  // Gap test at domain walls (RebuildGrid, WallTouchMarker; scene key domain.gap_test): a wall
+  // acts at a node only where a particle touches the wall in that node's column (its centre
+  // within 1.5 of its half-size of the plane); false: wherever a node on or beyond the wall has
+  // mass.
   bool wall_gap_test = true;
   ExitPolicy exit_policy = ExitPolicy::kRemove;
   std::vector<Material> materials;

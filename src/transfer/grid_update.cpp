@@ -27,14 +27,13 @@ WallTouchMarker::WallTouchMarker(const Model& model, Real dx, SparseGrid& grid)
   for (auto& t : grid.wall_touch) t.touched.clear();
   if (!model.wall_gap_test) return;
   count_ = ActiveWalls(model, walls_);
-  c_touch_ = model.dim == 3 ? 0.421875 : 0.5625;  // 0.75^dim
   for (int a = 0; a < 3; ++a) {
     near_.lo[a] = -std::numeric_limits<Real>::infinity();
     near_.hi[a] = std::numeric_limits<Real>::infinity();
   }
   for (int k = 0; k < count_; ++k)
     (walls_[k].sign > 0 ? near_.lo : near_.hi)[walls_[k].axis] = walls_[k].level;
-  near_.c_touch = c_touch_;
+  near_.c_touch = model.dim == 3 ? 0.421875 : 0.5625;  // 0.75^dim
   near_.cube = dim_ == 3;
   reach_ = dx * (model.shape == ShapeFunction::kLinear             ? 1.0
                  : model.shape == ShapeFunction::kQuadraticBspline ? 1.5
@@ -60,7 +59,7 @@ void WallTouchMarker::MarkTouched(const Vec3& x, Real volume0, Recent& recent) c
   for (int k = 0; k < count_; ++k) {
     const WallPlane& w = walls_[k];
     const Real d = w.sign * (x[w.axis] - w.level);
-    if (d <= 0 || (dim_ == 3 ? d * d * d : d * d) <= c_touch_ * volume0)
+    if (d <= 0 || (dim_ == 3 ? d * d * d : d * d) <= near_.c_touch * volume0)
       MarkColumns(x, volume0, k, recent.range[k]);
   }
 }
@@ -89,8 +88,10 @@ void WallTouchMarker::MarkColumns(const Vec3& x, Real volume0, int k, int* recen
   recent[2] = range[1][0];
   recent[3] = range[1][1];
   const int a1 = (t.axis + 1) % 3, a2 = (t.axis + 2) % 3;
-  for (int i1 = std::max(range[0][0] - t.lo[a1], 0); i1 <= std::min(range[0][1] - t.lo[a1], t.n1 - 1); ++i1)
-    for (int i2 = std::max(range[1][0] - t.lo[a2], 0); i2 <= std::min(range[1][1] - t.lo[a2], t.n2 - 1); ++i2)
+  const int i1_end = std::min(range[0][1] - t.lo[a1], t.n1 - 1);
+  const int i2_end = std::min(range[1][1] - t.lo[a2], t.n2 - 1);
+  for (int i1 = std::max(range[0][0] - t.lo[a1], 0); i1 <= i1_end; ++i1)
+    for (int i2 = std::max(range[1][0] - t.lo[a2], 0); i2 <= i2_end; ++i2)
       if (std::atomic_ref<uint8_t> mark(t.touched[size_t(i1) * t.n2 + i2]);
           mark.load(std::memory_order_relaxed) == 0)  // a line both threads mark stays shared
         mark.store(1, std::memory_order_relaxed);

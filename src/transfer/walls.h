@@ -35,14 +35,15 @@ inline int ActiveWalls(const Model& model, WallPlane* out) {
 // The gap test's marking (docs/walls.md "Stand-off"): a particle touches wall k when its
 // distance d to the plane is at most 1.5 of its half-size V0^(1/dim) / 2, tested without the
 // root (a cbrt was about 1 % of a step): d <= 0, or d^dim <= 0.75^dim V0. It then marks the node
-// columns along the wall that its kernel reaches. The constructor sizes and
-// clears grid.wall_touch (serial; the maps are small); Mark may run on any thread: a mark is a
+// columns along the wall that its kernel reaches. The constructor sizes and clears
+// grid.wall_touch (serial; the maps are small); MarkTouched may run on any thread: a mark is a
 // relaxed store of 1, so the maps are the same set for any thread count and particle order.
-// RebuildGrid marks in its pass over the particles (no pass of its own, no broad phase).
+// RebuildGrid marks in its pass over the particles (no pass of its own, no broad phase): a
+// particle that Near::MayTouch lets through goes to MarkTouched.
 class WallTouchMarker {
  public:
   WallTouchMarker(const Model& model, Real dx, SparseGrid& grid);
-  // Whether Mark has anything to do: the gap test is on and a wall is active.
+  // Whether there is anything to mark: the gap test is on and a wall is active.
   bool active() const { return count_ > 0; }
   // The node ranges last marked per wall (by one thread's run of particles): neighbouring
   // particles mostly mark the same columns, which are then skipped.
@@ -69,9 +70,6 @@ class WallTouchMarker {
   const Near& near() const { return near_; }
   // Tests x against every wall and marks the columns of those it touches.
   void MarkTouched(const Vec3& x, Real volume0, Recent& recent) const;
-  void Mark(const Vec3& x, Real volume0, Recent& recent) const {
-    if (near_.MayTouch(x, volume0)) MarkTouched(x, volume0, recent);
-  }
 
  private:
   void MarkColumns(const Vec3& x, Real volume0, int k, int* recent) const;
@@ -79,7 +77,6 @@ class WallTouchMarker {
   Near near_;
   int count_ = 0;
   int dim_ = 3;
-  Real c_touch_ = 0;
   Real reach_ = 0;  // kernel reach along the wall [m]: where the stencil has non-zero weights
   Real inv_dx_ = 0;
   bool gimp_ = false;

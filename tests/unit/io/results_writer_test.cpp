@@ -403,7 +403,8 @@ TEST_F(ResultsWriterTest, SigkillDuringWritesLeavesListedSnapshotsReadable) {
       char group[64];
       std::snprintf(group, sizeof group, "/snapshots/%06zu/", k);
       const std::string position = std::string(group) + "position", id = std::string(group) + "id";
-      whole = Dims(f, position) == std::vector<hsize_t>{n, 3} && Dims(f, id) == std::vector<hsize_t>{n};
+      whole = Dims(f, position) == std::vector<hsize_t>{n, 3} &&
+              Dims(f, id) == std::vector<hsize_t>{n};
       if (!whole) break;
       const auto pos = ReadDoubles(f, position);
       EXPECT_EQ(pos[3 * (n - 1)], double(n - 1)) << "trial " << trial << " snapshot " << k;
@@ -414,7 +415,8 @@ TEST_F(ResultsWriterTest, SigkillDuringWritesLeavesListedSnapshotsReadable) {
     if (f >= 0) H5Fclose(f);
     if (!whole) {
       ++torn;
-      std::printf("trial %d: a listed snapshot of %zu is unreadable after SIGKILL\n", trial, listed);
+      std::printf("trial %d: a listed snapshot of %zu is unreadable after SIGKILL\n", trial,
+                  listed);
     }
   }
   // A kill inside the flush or the close that commits a snapshot can still tear the file: HDF5
