@@ -152,6 +152,17 @@ TEST(DeterminismTest, ParticleShiftingIsBitwiseIdenticalForOneAndTwoThreads) {
   EXPECT_NE(h1, RunWithThreads("dam_break_barrier_2d.yaml", {}, 0.6, 2));
 }
 
+TEST(DeterminismTest, SettleRecipeIsBitwiseIdenticalForOneAndTwoThreads) {
+  // The settle recipe of docs/antilocking.md (the linear node fit with its extrapolation limit,
+  // the ghosts folded at the frictionless walls, particle shifting) through the barrier impact.
+  const std::vector<std::string> recipe = {
+      "materials.water.particle_shifting=true", "domain.ghost_nodes=fold_all",
+      "materials.water.antilocking={method: node, approach: volumetric_deviatoric}"};
+  const uint64_t h1 = RunWithThreads("dam_break_barrier_2d.yaml", recipe, 0.6, 1);
+  EXPECT_EQ(h1, RunWithThreads("dam_break_barrier_2d.yaml", recipe, 0.6, 2));
+  EXPECT_NE(h1, RunWithThreads("dam_break_barrier_2d.yaml", {recipe[0], recipe[1]}, 0.6, 2));
+}
+
 TEST(DeterminismTest, MirroredGhostNodesAreBitwiseIdenticalForOneAndTwoThreads) {
   // The 3-D drop (quadratic B-splines, USL) landing on the floor, and the sand column with MUSL
   // (the mirror is applied again to the re-mapped velocity); both with domain.ghost_nodes: mirror.
