@@ -73,6 +73,11 @@ struct AntiLocking {
   // spec §3.3), instead of its `TriLinearAntiLocking` (S rows [1, xi, eta, zeta]). AS1 is constant
   // either way.
   bool constant_fit = false;
+  // Node-based AS1 with `fit: linear`: each node's theta is its support's weighted least-squares
+  // linear fit evaluated at the node (the full-tensor node fit of the trace alone) instead of the
+  // support's mean, which is the value at the support's centroid, half a cell inside a wall or a
+  // free surface (docs/antilocking.md, "Linear node fit").
+  bool linear_trace = false;
 };
 
 // Cundall's local non-viscous damping of the grid momentum balance (Anura3D manual §6.3.1, eqs.

@@ -580,10 +580,13 @@ AntiLockingSpec Parser::ParseAntiLocking(const YAML::Node& al, const std::string
       Fail(fit, Child(ap, "fit"), "fit needs a control volume: method node, cell or hybrid");
     }
     if (!a.constant_fit && a.approach == AntiLockingApproach::kVolumetric) {
-      Fail(fit, Child(ap, "fit"),
-           "the volumetric approach (AS1) projects a constant over each control volume: fit "
-           "constant (or leave it out); a linear fit needs approach volumetric_deviatoric or "
-           "constant_volumetric");
+      if (*a.method != AntiLockingMethod::kNode) {
+        Fail(fit, Child(ap, "fit"),
+             "the volumetric approach (AS1) projects a constant over each cell: fit constant (or "
+             "leave it out); a linear fit of the trace alone needs method node, a cell's linear "
+             "fit approach volumetric_deviatoric or constant_volumetric");
+      }
+      a.linear_trace = true;  // node-based AS1, each node's trace fitted linearly
     }
   }
   // Anura3D smooths the strain rate (manual (6.34)-(6.37)): the increment by default.
@@ -1582,6 +1585,7 @@ AntiLocking ResolvedAntiLocking(const MaterialSpec& m) {
   a.approach = m.antilocking.approach;
   a.stress = m.antilocking.stress;
   a.constant_fit = m.antilocking.constant_fit;
+  a.linear_trace = m.antilocking.linear_trace;
   if (m.antilocking.method) {
     a.method = *m.antilocking.method;
   } else {
@@ -1604,13 +1608,14 @@ AntiLocking ResolvedAntiLocking(const SceneSpec& spec, const BodySpec& b) {
   if (!b.antilocking) return ResolvedAntiLocking(spec.materials.at(size_t(b.material_index)));
   // A body's own setting always names its method (ParseAntiLocking requires it).
   return AntiLocking{*b.antilocking->method, b.antilocking->approach, b.antilocking->strain,
-                     b.antilocking->stress, b.antilocking->constant_fit};
+                     b.antilocking->stress, b.antilocking->constant_fit,
+                     b.antilocking->linear_trace};
 }
 
 namespace {
 
 // `antilocking: {method, approach, strain[, stress][, fit]}` in full (stress only when on, fit only
-// when constant for a full-tensor approach).
+// when constant for a full-tensor approach or linear for node-based AS1).
 void EmitAntiLocking(YAML::Emitter& e, const AntiLocking& al) {
   e << YAML::Key << "antilocking" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
     << "method" << YAML::Value << NameOf(kAntiLockingNames, al.method) << YAML::Key
@@ -1620,6 +1625,7 @@ void EmitAntiLocking(YAML::Emitter& e, const AntiLocking& al) {
   if (al.constant_fit && al.approach != AntiLockingApproach::kVolumetric) {
     e << YAML::Key << "fit" << YAML::Value << "constant";
   }
+  if (al.linear_trace) e << YAML::Key << "fit" << YAML::Value << "linear";
   e << YAML::EndMap;
 }
 

@@ -81,6 +81,7 @@ struct AntiLockingSpec {
   AntiLockingStrain strain = AntiLockingStrain::kTotal;
   bool stress = false;  // `stress: true`: Table 4.1 steps 6-7
   bool constant_fit = false;  // `fit: constant`: the seed's ConstantAntiLocking
+  bool linear_trace = false;  // `fit: linear` with method node, approach volumetric
 };
 
 struct MaterialSpec {

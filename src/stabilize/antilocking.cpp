@@ -512,9 +512,11 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
   // `fit: constant` (the seed's ConstantAntiLocking): every component the control volume's
   // weighted mean, as the singularity fallback (an infinite spread threshold) everywhere.
   constexpr Real kAlwaysConstant = std::numeric_limits<Real>::infinity();
-  // Tank at rest (fold_all): pressure RMS 0.0110 / 0.0117 / 0.0135 at 1.5 / 2 / 3 (unlimited:
-  // 0.0135, but the barrier blows up).
-  constexpr Real kMaxNodeExtrapolation = 2;
+  // 4 keeps the fit exact at the corner nodes of a full lattice (3-D: just over 3 standard
+  // deviations; antilocking_projection_test) and cuts the wall ghost's 9 to 4. Tank at rest
+  // (fold_all): pressure RMS 0.0110 / 0.0117 / 0.0136 / 0.0136 at 1.5 / 2 / 3 / 4, unlimited
+  // 0.0135, but then the full-tensor fit blows the barrier up (2026-12-07).
+  constexpr Real kMaxNodeExtrapolation = 4;
   s.moments.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(M), 0.0);
   for (int colour = 0; colour < 8; ++colour) {
     const auto& blocks = grid.colour[colour];
@@ -544,10 +546,10 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
         // takes the linear fit only when its particles spread over tr C > 0.05 cell^2 (an RMS
         // spread of about 0.13 cells per axis) with det C > 1e-3 (tr C / dim)^dim. Even then the
         // ghost node beyond a wall sees only a strip half a cell thick, 1.25 cells away: its
-        // slope across the strip, extrapolated over about 9 standard deviations, blew the dam
-        // break with barrier up at the folded side wall (2026-12-07), so the fit is evaluated at
-        // most kMaxNodeExtrapolation standard deviations from the centroid (docs/antilocking.md,
-        // "Linear node fit at walls and free surfaces").
+        // slopes, extrapolated over about 9 standard deviations of the strip, blew the full-tensor
+        // fit of the dam break with barrier up at the folded side wall (2026-12-07), so the fit
+        // is evaluated at most kMaxNodeExtrapolation standard deviations from the centroid
+        // (docs/antilocking.md, "Linear node fit at walls and free surfaces").
         F fit = CellFit<kDim>(a, Eigen::Matrix<Real, kDim, 1>::Zero(), nullptr,
                               al.constant_fit ? kAlwaysConstant : 0.05, 1e-3,
                               kMaxNodeExtrapolation);
@@ -647,6 +649,35 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
     const Mat3 f = Increment(ctx.dt, L[p]);  // (2.18)
     const Mat3 f_bar = ProjectedIncrement<kDim>(f, eps_h, s.inv_stretch[p]);
     if (f_bar.allFinite()) L[p] = (f_bar - Mat3::Identity()) / ctx.dt;
+  });
+}
+
+// Node-based AS1 with `fit: linear` (AntiLocking::linear_trace): theta_p (TrialTheta) is fitted
+// as the trace of the isotropic tensor (theta_p / dim) 1 by the full-tensor node fit (its
+// deviators are zero), so each node takes its support's linear fit of theta at the node, within
+// kMaxNodeExtrapolation standard deviations (4.29)-(4.31) with S rows [1, xi, eta, zeta], and
+// theta-bar_p = sum_i N_ip theta-hat_i (4.32)_1. The particle then shifts as in AS1 (seed §3.5).
+// No spectral decomposition: the fit of a fluid's trace without the full tensor's cost.
+template <int kDim, class K>
+void ProjectLinearTrace(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
+                        size_t begin, size_t end, const SparseGrid& grid, const Mode& mode,
+                        const AntiLocking& al, AntiLockingScratch& s, std::vector<Mat3>& L) {
+  const size_t n = P.size();
+  s.theta.resize(n);
+  s.tensor.resize(n);
+  s.tensor_ok.resize(n);
+  ParallelFor(end - begin, 1024, [&](size_t i) {
+    const size_t p = begin + i;
+    const Real theta = TrialTheta<kDim>(Increment(ctx.dt, L[p]), P, p, mode);  // (2.18)
+    s.theta[p] = theta;
+    Mat3 t = Mat3::Zero();
+    for (int d = 0; d < kDim; ++d) t(d, d) = theta / kDim;  // 2-D: the in-plane trace
+    s.tensor[p] = t;
+    s.tensor_ok[p] = std::isfinite(theta);  // else left to CheckState
+  });
+  FitFullTensor<kDim, K>(ctx, P, x_n, begin, end, grid, al, s, [&](size_t p, const Mat3& e) {
+    const Real theta_bar = kDim == 3 ? e.trace() : e(0, 0) + e(1, 1);
+    if (std::isfinite(theta_bar)) ShiftVolumetric<kDim>(ctx, s.theta[p], theta_bar, L[p]);
   });
 }
 
@@ -798,6 +829,12 @@ void ProjectVolumetricStrain(const Model& model, const StepContext& ctx,
     if (method == AntiLockingMethod::kHybrid || al.approach != AntiLockingApproach::kVolumetric) {
       DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
         ProjectFullTensor<kDim, K>(ctx, particles, x_n, g.begin, g.end, grid, mode, al, scratch, L);
+      });
+      continue;
+    }
+    if (al.linear_trace) {
+      DispatchKernel(model.dim, model.shape, [&]<int kDim, class K>() {
+        ProjectLinearTrace<kDim, K>(ctx, particles, x_n, g.begin, g.end, grid, mode, al, scratch, L);
       });
       continue;
     }

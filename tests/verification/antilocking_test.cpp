@@ -590,7 +590,7 @@ TEST(AntilockingTest, ParticleShiftingRemovesTheFloorCrowdingOfTheSettledBarrier
 // rest RMS 0.0118 (node AS1 with the default mirror 0.0326; node AS1 with fold_all 0.053; the
 // linear fit with the mirror 0.076, and the floor reaction still rings at 6 % of the weight).
 TEST(AntilockingTest, LinearNodeFitWithFoldedGhostsGivesHydrostaticTank) {
-  const std::string linear = "node, approach: volumetric_deviatoric";
+  const std::string linear = "node, fit: linear";
   const Real folded = TankPressureRms(linear, "fold_all");
   const Real node = TankPressureRms("node");
   std::printf("tank: linear node fit with fold_all %.4f; node AS1 %.4f\n", folded, node);
@@ -607,7 +607,7 @@ TEST(AntilockingTest, LinearNodeFitWithFoldedGhostsGivesHydrostaticTank) {
 // run blew up at the folded side wall. The gate is 5 %. 27 s.
 TEST(AntilockingTest, LinearNodeFitSettlesTheBarrierHydrostaticWithinFivePercent) {
   const SettledBarrier r =
-      BarrierSettled("fold_all", "node, approach: volumetric_deviatoric", true, 6.0);
+      BarrierSettled("fold_all", "node, fit: linear", true, 6.0);
   EXPECT_LT(r.rms, 0.035);
   EXPECT_NEAR(r.crowding, 1.0, 0.03);
 }

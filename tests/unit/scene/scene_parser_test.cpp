@@ -831,6 +831,8 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
   {  // fit: the seed's ConstantAntiLocking (constant) or TriLinearAntiLocking (linear, default)
     ExpectError(WithMaterial(steel + "antilocking: {method: cell, fit: linear}}"), 7,
                 "materials.steel.antilocking.fit", "the volumetric approach (AS1) projects a constant");
+    ExpectError(WithMaterial(steel + "antilocking: {method: smoothing, fit: linear}}"), 7,
+                "materials.steel.antilocking.fit", "a linear fit of the trace alone needs method node");
     ExpectError(WithMaterial(steel + "antilocking: {method: none, fit: constant}}"), 7,
                 "materials.steel.antilocking.fit", "needs a control volume");
     ExpectError(WithMaterial(steel + "antilocking: {method: cell, fit: quadratic}}"), 7,
@@ -845,7 +847,20 @@ TEST(SceneParserTest, AntiLockingKeysAndDefaults) {
         WithMaterial(steel + "antilocking: {method: node, approach: volumetric_deviatoric, fit: linear}}"),
         "ok.yaml");
     EXPECT_FALSE(linear.model.antilocking[0].constant_fit);
+    EXPECT_FALSE(linear.model.antilocking[0].linear_trace);
     EXPECT_EQ(linear.resolved_yaml.find("fit:"), std::string::npos) << "written only when constant";
+    // Node-based AS1 with the linear node fit of the trace (docs/antilocking.md, "Linear node
+    // fit"): parsed, written back, read again.
+    const LoadedScene trace = LoadSceneFromString(
+        WithMaterial(steel + "antilocking: {method: node, fit: linear}}"), "ok.yaml");
+    EXPECT_TRUE(trace.model.antilocking[0].linear_trace);
+    EXPECT_EQ(trace.model.antilocking[0].approach, AntiLockingApproach::kVolumetric);
+    EXPECT_NE(trace.resolved_yaml.find("fit: linear"), std::string::npos) << trace.resolved_yaml;
+    EXPECT_TRUE(
+        LoadSceneFromString(trace.resolved_yaml, "again.yaml").model.antilocking[0].linear_trace);
+    EXPECT_FALSE(LoadSceneFromString(WithMaterial(steel + "antilocking: {method: node}}"), "ok.yaml")
+                     .model.antilocking[0]
+                     .linear_trace);
   }
   ExpectError(WithMaterial(steel + "antilocking: {method: none, stress: true}}"), 7,
               "materials.steel.antilocking.stress", "needs a control volume");
