@@ -579,15 +579,15 @@ TEST(AntilockingTest, ParticleShiftingRemovesTheFloorCrowdingOfTheSettledBarrier
   EXPECT_LT(shifted.rms, 0.85 * node.rms);
 }
 
-// The linear node fit (`method: node, approach: volumetric_deviatoric`: each node's value is
-// its support's weighted least-squares linear fit evaluated at the node, seed (4.29)-(4.32))
+// The linear node fit (`{method: node, fit: linear}`: each node's trace is its support's
+// weighted least-squares linear fit evaluated at the node, seed (4.29)-(4.32))
 // with the ghost nodes folded at every frictionless wall (`domain.ghost_nodes: fold_all`,
 // docs/walls.md), the settle recipe of docs/antilocking.md. The plain node average (AS1) takes
 // the support's centroid value: at a floor node the centroid lies about half a cell inside the
 // water, at a surface node half a cell below the surface, so the interpolated pressure is
 // biased low at the floor and high at the surface. The linear fit removes that bias, but only
 // with the fold: with the velocity mirror it is worse than AS1. Measured 2026-12-07: tank at
-// rest RMS 0.0118 (node AS1 with the default mirror 0.0326; node AS1 with fold_all 0.053; the
+// rest RMS 0.0136 (node AS1 with the default mirror 0.0326; node AS1 with fold_all 0.053; the
 // linear fit with the mirror 0.076, and the floor reaction still rings at 6 % of the weight).
 TEST(AntilockingTest, LinearNodeFitWithFoldedGhostsGivesHydrostaticTank) {
   const std::string linear = "node, fit: linear";
@@ -601,10 +601,11 @@ TEST(AntilockingTest, LinearNodeFitWithFoldedGhostsGivesHydrostaticTank) {
 // The settle recipe on the seed's dam break with barrier (§6.1.2): undamped through the impact
 // to 2 s, damped (alpha = 0.7) to 6 s, pressure averaged over 6-6.25 s, with the linear node
 // fit, folded ghosts and particle shifting (docs/antilocking.md, "Linear node fit"). Measured
-// 2026-12-07: RMS 0.0192, bottom band crowding 0.992 (the default, node AS1 with mirrored
-// ghosts and shifting: 0.048 at 6 s, 0.054-0.058 at 4-14 s; the recipe without shifting 0.034,
-// crowding 1.058). Without the extrapolation limit of the node fit (kMaxNodeExtrapolation) this
-// run blew up at the folded side wall. The gate is 5 %. 27 s.
+// 2026-12-07: RMS 0.0183, bottom band crowding 0.989 (the default, node AS1 with mirrored
+// ghosts and shifting: 0.048 at 6 s, 0.054-0.058 at 4-14 s; the recipe without shifting 0.032,
+// crowding 1.044). With node AS2 instead of `fit: linear` and no extrapolation limit
+// (kMaxNodeExtrapolation) this run blew up at the folded side wall. The gate is 5 %.
+// 20-40 s.
 TEST(AntilockingTest, LinearNodeFitSettlesTheBarrierHydrostaticWithinFivePercent) {
   const SettledBarrier r =
       BarrierSettled("fold_all", "node, fit: linear", true, 6.0);
