@@ -563,13 +563,18 @@ int SweepCommand(const SweepCommandOptions& o) {
   const bool completed_skip = !o.force;
   std::vector<size_t> todo;
   int skipped = 0;
-  for (size_t i = 0; i < views.size(); ++i) {
-    if (completed_skip && views[i].status == "completed") {
-      ++skipped;
-    } else {
-      todo.push_back(i);
+  const auto plan = [&] {  // the cases to run: all with --force, else those not completed
+    todo.clear();
+    skipped = 0;
+    for (size_t i = 0; i < views.size(); ++i) {
+      if (completed_skip && views[i].status == "completed") {
+        ++skipped;
+      } else {
+        todo.push_back(i);
+      }
     }
-  }
+  };
+  plan();
   const int hardware = int(std::max(1u, std::thread::hardware_concurrency()));
   const int jobs = o.jobs > 0 ? o.jobs : spec.jobs > 0 ? spec.jobs : std::max(1, hardware / spec.threads_per_case);
 
@@ -607,6 +612,10 @@ int SweepCommand(const SweepCommandOptions& o) {
     throw std::runtime_error("another surge sweep, or cases left running by one that was killed, "
                              "still run in " + spec.out + " (lock: " + lock_path + ")");
   }
+  // Inspected again under the lock: a case left running by a killed sweep holds the lock until
+  // it ends, and may have completed after the first inspection (it was then started twice).
+  for (size_t i = 0; i < views.size(); ++i) views[i] = InspectCase(spec, *selected[i], scenes[i]);
+  plan();
 
   std::printf("sweep %s: %d cases, %zu to run (%d completed before), %d at a time x %d thread(s); results in %s\n",
               spec.path.c_str(), n, todo.size(), skipped, jobs, spec.threads_per_case, spec.out.c_str());
