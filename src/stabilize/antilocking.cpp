@@ -264,10 +264,13 @@ void DispatchProjection(const Model& model, AntiLockingMethod method, const Body
 // components, which vary linearly over a control volume (S rows [1, xi, eta, zeta]), then the
 // shears, constant. 3-D: {tr eps, e11, e22 | eps12, eps13, eps23}, e33 = -e11 - e22. 2-D (plane
 // strain, the in-plane block): {eps11 + eps22, (eps11 - eps22)/2 | eps12}.
-template <int kDim>
+// kTrace: the trace alone, linear (node-based AS1 with `fit: linear`, ProjectLinearTrace): 14
+// moments per node in 3-D and 9 in 2-D instead of 25 and 13, the same sums for the trace.
+template <int kDim, bool kTrace = false>
 struct Filtered {
-  static constexpr int kLinear = kDim == 3 ? 3 : 2;   // linear components, the trace first
-  static constexpr int kConst = kDim == 3 ? 3 : 1;    // constant components (shears)
+  static constexpr bool kTraceOnly = kTrace;
+  static constexpr int kLinear = kTrace ? 1 : kDim == 3 ? 3 : 2;  // linear components, trace first
+  static constexpr int kConst = kTrace ? 0 : kDim == 3 ? 3 : 1;   // constant components (shears)
   static constexpr int kSym = kDim * (kDim + 1) / 2;  // entries of sum w xi xi^T
   // Moment sums of one cell: sum w, sum w xi, sum w xi xi^T, per linear component sum w q and
   // sum w xi q, per constant component sum w q (the normal equations of (4.25)_1, as particle
@@ -276,6 +279,7 @@ struct Filtered {
   std::array<Real, kLinear + kConst> q;
 
   static Filtered Of(const Mat3& e) {
+    static_assert(!kTrace);
     Filtered r;
     if constexpr (kDim == 3) {
       const Real tr = e.trace();
@@ -288,6 +292,7 @@ struct Filtered {
   // The reconstruction M* (4.19): the tensor of these components; in 2-D the out-of-plane
   // entries are the particle's own (`own`), the in-plane/out-of-plane shears zero.
   Mat3 Tensor(const Mat3& own) const {
+    static_assert(!kTrace);
     Mat3 e;
     if constexpr (kDim == 3) {
       const Real t = q[0] / 3;
@@ -330,11 +335,10 @@ Eigen::Matrix<Real, kDim, 1> CellXi(const Vec3& x, Real inv_dx, Vec3i& cell) {
 // support's own metric, (xi - c)^T C^-1 (xi - c) > max_dist^2, is pulled back along xi - c onto
 // that ellipsoid (the linear fit's variance grows as that distance squared; a limiter of ours,
 // not the seed's).
-template <int kDim>
-Filtered<kDim> CellFit(const Real* a, const Eigen::Matrix<Real, kDim, 1>& xi, bool* linear_out,
-                       Real min_trace = 1e-8, Real min_det = 1e-10,
-                       Real max_dist = std::numeric_limits<Real>::infinity()) {
-  using F = Filtered<kDim>;
+template <int kDim, class F = Filtered<kDim>>
+F CellFit(const Real* a, const Eigen::Matrix<Real, kDim, 1>& xi, bool* linear_out,
+          Real min_trace = 1e-8, Real min_det = 1e-10,
+          Real max_dist = std::numeric_limits<Real>::infinity()) {
   using VecD = Eigen::Matrix<Real, kDim, 1>;
   using MatD = Eigen::Matrix<Real, kDim, kDim>;
   const Real s0 = a[0];
@@ -428,9 +432,8 @@ Mat3 ProjectedIncrement(const Mat3& f, const Mat3& eps_h, const Mat3& inv_stretc
 
 // Adds one particle's weighted moments (weight w at position xi, components f) to the sums `a`
 // (layout of Filtered::kMoments).
-template <int kDim>
-void AddMoments(Real* a, Real w, const Eigen::Matrix<Real, kDim, 1>& xi, const Filtered<kDim>& f) {
-  using F = Filtered<kDim>;
+template <int kDim, class F>
+[[gnu::always_inline]] inline void AddMoments(Real* a, Real w, const Eigen::Matrix<Real, kDim, 1>& xi, const F& f) {
   int j = 0;
   a[j++] += w;
   for (int d = 0; d < kDim; ++d) a[j++] += w * xi[d];
@@ -444,11 +447,11 @@ void AddMoments(Real* a, Real w, const Eigen::Matrix<Real, kDim, 1>& xi, const F
 }
 
 // Flushes a block's padded moment buffer into the grid slots (stride kMoments).
-template <int kDim, class K>
+template <int kDim, class K, class F>
 void FlushMoments(const SparseGrid& grid, size_t blk, const std::vector<Real>& buf,
                   AntiLockingScratch& s) {
   using Pad = BlockPad<kDim, K>;
-  constexpr int M = Filtered<kDim>::kMoments;
+  constexpr int M = F::kMoments;
   for (int a = 0; a < Pad::E; ++a)
     for (int b = 0; b < Pad::E; ++b)
       for (int c = 0; c < Pad::Ez; ++c) {
@@ -467,12 +470,12 @@ void FlushMoments(const SparseGrid& grid, size_t blk, const std::vector<Real>& b
 // kMoments). Cell-based (4.25)_1: weight m_p at xi = the position in the cell (CellXi), in the
 // slot of the cell's lower-corner node. Node-based (4.29)_1 with H_i = sum S^T S N_ip m_p: weight
 // N_ip m_p at every node of the stencil, at xi = (x_p - x_i)/dx (node-centred, cell units).
-template <int kDim, class K, bool kNode>
+// The components: the filter of s.tensor[p], or with F::kTraceOnly the trace s.theta[p].
+template <int kDim, class K, bool kNode, class F>
 void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
                     size_t begin, size_t end, const SparseGrid& grid, size_t blk,
                     std::vector<Real>& buf, AntiLockingScratch& s) {
   using Pad = BlockPad<kDim, K>;
-  using F = Filtered<kDim>;
   constexpr int M = F::kMoments;
   buf.assign(size_t(Pad::kSize) * M, 0.0);
   const Vec3i origin = grid.block_origin[blk];
@@ -481,7 +484,11 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
     const uint32_t p = grid.sorted[k];
     if (p < begin || p >= end || !s.tensor_ok[p]) continue;
     any = true;
-    const F f = F::Of(s.tensor[p]);
+    F f;
+    if constexpr (F::kTraceOnly)
+      f.q[0] = s.theta[p];
+    else
+      f = F::Of(s.tensor[p]);
     if constexpr (kNode) {
       Stencil<kDim, K> st;
       st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
@@ -494,17 +501,17 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
             const int idx[3] = {i, j, c};
             Eigen::Matrix<Real, kDim, 1> xi;
             for (int d = 0; d < kDim; ++d) xi[d] = x_n[p][d] * ctx.inv_dx - (st.base[d] + idx[d]);
-            AddMoments<kDim>(&buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * M],
-                             w * P.mass[p], xi, f);
+            AddMoments<kDim, F>(&buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * M],
+                                w * P.mass[p], xi, f);
           }
     } else {
       Vec3i cell;
       const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
       const Vec3i lc = cell - origin;
-      AddMoments<kDim>(&buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M], P.mass[p], xi, f);
+      AddMoments<kDim, F>(&buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M], P.mass[p], xi, f);
     }
   }
-  if (any) FlushMoments<kDim, K>(grid, blk, buf, s);
+  if (any) FlushMoments<kDim, K, F>(grid, blk, buf, s);
 }
 
 // The full-tensor approximation of one material group's per-particle tensor field s.tensor (the
@@ -512,21 +519,31 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
 // (trace from node-based AS1, deviator from cell-based AS2). Hands each particle's approximated
 // tensor to apply(p, tensor) (seed Table 4.1 steps 3 and 6: (4.25)-(4.27), (4.29)-(4.32),
 // (4.33)-(4.35)). In 2-D the out-of-plane normal entry is the particle's own.
-template <int kDim, class K, class Apply>
+// F = Filtered<kDim, true>: the trace s.theta[p] alone, node-based (ProjectLinearTrace);
+// apply(p, theta-hat_p) receives the fitted trace.
+template <int kDim, class K, class F = Filtered<kDim>, class Apply>
 void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
                    size_t begin, size_t end, const SparseGrid& grid, const AntiLocking& al,
                    AntiLockingScratch& s, const Apply& apply) {
-  using F = Filtered<kDim>;
   constexpr int M = F::kMoments;
+  // The fitted components handed to apply: the reconstructed tensor M* (4.19), or the trace.
+  const auto hand = [&](size_t p, const F& fit) {
+    if constexpr (F::kTraceOnly)
+      apply(p, fit.q[0]);
+    else
+      apply(p, fit.Tensor(s.tensor[p]));
+  };
   // Hybrid, volumetric part: node-based AS1 of the trace (4.29)-(4.32), (4.34)_1, (4.35)_1.
-  const bool hybrid = al.method == AntiLockingMethod::kHybrid;
-  if (hybrid) {
-    s.theta_bar.assign(P.size(), std::numeric_limits<Real>::quiet_NaN());
-    const auto theta = [&](size_t p) {
-      return s.tensor_ok[p] ? F::Of(s.tensor[p]).q[0] : std::numeric_limits<Real>::quiet_NaN();
-    };
-    const auto keep = [&](size_t p, Real theta_bar) { s.theta_bar[p] = theta_bar; };
-    Project<kDim, K, true>(ctx, P, x_n, begin, end, grid, s, theta, keep);
+  const bool hybrid = !F::kTraceOnly && al.method == AntiLockingMethod::kHybrid;
+  if constexpr (!F::kTraceOnly) {
+    if (hybrid) {
+      s.theta_bar.assign(P.size(), std::numeric_limits<Real>::quiet_NaN());
+      const auto theta = [&](size_t p) {
+        return s.tensor_ok[p] ? F::Of(s.tensor[p]).q[0] : std::numeric_limits<Real>::quiet_NaN();
+      };
+      const auto keep = [&](size_t p, Real theta_bar) { s.theta_bar[p] = theta_bar; };
+      Project<kDim, K, true>(ctx, P, x_n, begin, end, grid, s, theta, keep);
+    }
   }
   // Cell moments (4.25) with H_c = sum S^T S m, or node moments (4.29) with H_i = sum S^T S N m,
   // colour-phased as every scatter.
@@ -546,9 +563,9 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
     ParallelFor(blocks.size(), 1, [&](size_t i) {
       thread_local std::vector<Real> buf;
       if (node) {
-        ScatterMoments<kDim, K, true>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+        ScatterMoments<kDim, K, true, F>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
       } else {
-        ScatterMoments<kDim, K, false>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
+        ScatterMoments<kDim, K, false, F>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
       }
     });
   }
@@ -573,9 +590,9 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
         // fit of the dam break with barrier up at the folded side wall (2026-12-07), so the fit
         // is evaluated at most kMaxNodeExtrapolation standard deviations from the centroid
         // (docs/antilocking.md, "Linear node fit at walls and free surfaces").
-        F fit = CellFit<kDim>(a, Eigen::Matrix<Real, kDim, 1>::Zero(), nullptr,
-                              al.constant_fit ? kAlwaysConstant : 0.05, 1e-3,
-                              kMaxNodeExtrapolation);
+        F fit = CellFit<kDim, F>(a, Eigen::Matrix<Real, kDim, 1>::Zero(), nullptr,
+                                 al.constant_fit ? kAlwaysConstant : 0.05, 1e-3,
+                                 kMaxNodeExtrapolation);
         if (constant_trace) fit.q[0] = a[1 + kDim + F::kSym] / a[0];  // AS3CV (4.23)
         for (int q = 0; q < Q; ++q) s.node_fit[g * Q + size_t(q)] = fit.q[q];
       }
@@ -614,7 +631,7 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
               const Real* h = &halo[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * Q];
               for (int q = 0; q < Q; ++q) sum.q[q] += w * h[q];
             }
-        apply(p, sum.Tensor(s.tensor[p]));
+        hand(p, sum);
       }
     });
     return;
@@ -635,14 +652,14 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
       SURGE_ASSERT(g >= 0);
       if (g < 0) continue;
       const Real* a = &s.moments[size_t(g) * M];
-      F fit = CellFit<kDim>(a, xi, nullptr, al.constant_fit ? kAlwaysConstant : 1e-8);
+      F fit = CellFit<kDim, F>(a, xi, nullptr, al.constant_fit ? kAlwaysConstant : 1e-8);
       if (hybrid) {
         if (!std::isfinite(s.theta_bar[p])) continue;  // left to CheckState
         fit.q[0] = s.theta_bar[p];
       } else if (constant_trace) {
         fit.q[0] = a[1 + kDim + F::kSym] / a[0];  // AS3CV: the trace constant (4.23)
       }
-      apply(p, fit.Tensor(s.tensor[p]));
+      hand(p, fit);
     }
   });
 }
@@ -676,8 +693,8 @@ void ProjectFullTensor(const StepContext& ctx, const Particles& P, const std::ve
 }
 
 // Node-based AS1 with `fit: linear` (AntiLocking::linear_trace): theta_p (TrialTheta) is fitted
-// as the trace of the isotropic tensor (theta_p / dim) 1 by the full-tensor node fit (its
-// deviators are zero), so each node takes its support's linear fit of theta at the node, within
+// linearly over each node's support by the full-tensor node fit reduced to the trace
+// (Filtered<kDim, true>), so each node takes its support's linear fit of theta at the node, within
 // kMaxNodeExtrapolation standard deviations (4.29)-(4.31) with S rows [1, xi, eta, zeta], and
 // theta-bar_p = sum_i N_ip theta-hat_i (4.32)_1. The particle then shifts as in AS1 (seed §3.5).
 // No spectral decomposition: the fit of a fluid's trace without the full tensor's cost.
@@ -687,21 +704,17 @@ void ProjectLinearTrace(const StepContext& ctx, const Particles& P, const std::v
                         const AntiLocking& al, AntiLockingScratch& s, std::vector<Mat3>& L) {
   const size_t n = P.size();
   s.theta.resize(n);
-  s.tensor.resize(n);
   s.tensor_ok.resize(n);
   ParallelFor(end - begin, 1024, [&](size_t i) {
     const size_t p = begin + i;
     const Real theta = TrialTheta<kDim>(Increment(ctx.dt, L[p]), P, p, mode);  // (2.18)
     s.theta[p] = theta;
-    Mat3 t = Mat3::Zero();
-    for (int d = 0; d < kDim; ++d) t(d, d) = theta / kDim;  // 2-D: the in-plane trace
-    s.tensor[p] = t;
     s.tensor_ok[p] = std::isfinite(theta);  // else left to CheckState
   });
-  FitFullTensor<kDim, K>(ctx, P, x_n, begin, end, grid, al, s, [&](size_t p, const Mat3& e) {
-    const Real theta_bar = kDim == 3 ? e.trace() : e(0, 0) + e(1, 1);
-    if (std::isfinite(theta_bar)) ShiftVolumetric<kDim>(ctx, s.theta[p], theta_bar, L[p]);
-  });
+  FitFullTensor<kDim, K, Filtered<kDim, true>>(
+      ctx, P, x_n, begin, end, grid, al, s, [&](size_t p, Real theta_bar) {
+        if (std::isfinite(theta_bar)) ShiftVolumetric<kDim>(ctx, s.theta[p], theta_bar, L[p]);
+      });
 }
 
 // AS2 / AS3CV / hybrid on the stress of one material group (seed Table 4.1 steps 6-7, (4.25)_2,
