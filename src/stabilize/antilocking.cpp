@@ -446,6 +446,31 @@ template <int kDim, class F>
   for (int l = 0; l < F::kConst; ++l) a[j++] += w * f.q[F::kLinear + l];
 }
 
+// The moments of AddMoments' layout as products: moment mi is w prod_d xi_d^e[mi][d], times the
+// component q[comp[mi]] (comp -1: none).
+template <int kDim, class F>
+struct MomentExponents {
+  std::array<std::array<int, 3>, F::kMoments> e{};
+  std::array<int, F::kMoments> comp{};
+  constexpr MomentExponents() {
+    int j = 0;
+    const auto put = [&](int d0, int d1, int component) {  // d0, d1: an axis each, or -1
+      if (d0 >= 0) ++e[size_t(j)][size_t(d0)];
+      if (d1 >= 0) ++e[size_t(j)][size_t(d1)];
+      comp[size_t(j++)] = component;
+    };
+    put(-1, -1, -1);
+    for (int d = 0; d < kDim; ++d) put(d, -1, -1);
+    for (int d = 0; d < kDim; ++d)
+      for (int b = d; b < kDim; ++b) put(d, b, -1);
+    for (int l = 0; l < F::kLinear; ++l) {
+      put(-1, -1, l);
+      for (int d = 0; d < kDim; ++d) put(d, -1, l);
+    }
+    for (int l = 0; l < F::kConst; ++l) put(-1, -1, F::kLinear + l);
+  }
+};
+
 // Flushes a block's padded moment buffer into the grid slots (stride kMoments).
 template <int kDim, class K, class F>
 void FlushMoments(const SparseGrid& grid, size_t blk, const std::vector<Real>& buf,
@@ -490,20 +515,34 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
     else
       f = F::Of(s.tensor[p]);
     if constexpr (kNode) {
+      // The node moments separate along the axes: with N_ip = w_x w_y w_z and xi = (x_p - x_i)/dx,
+      // every moment of AddMoments is m q^(0|1) prod_d w_d xi_d^e_d (MomentExponents), formed as
+      // a per-(i, j) factor U times a per-z-node factor V: M multiply-adds per node, in lanes.
+      constexpr MomentExponents<kDim, F> kE{};
       Stencil<kDim, K> st;
       st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
       const Vec3i lb = st.base - origin;
+      Real pw[3][3][Stencil<kDim, K>::W];  // [axis][exponent e][node k]: w_d(k) xi_d(k)^e
+      for (int d = 0; d < 3; ++d)
+        for (int k = 0; k < (d < kDim ? st.W : 1); ++k) {
+          const Real xi = d < kDim ? x_n[p][d] * ctx.inv_dx - (st.base[d] + k) : 0.0;
+          pw[d][0][k] = st.w[d][k];
+          pw[d][1][k] = st.w[d][k] * xi;
+          pw[d][2][k] = st.w[d][k] * xi * xi;
+        }
+      Real qm[M], v[Stencil<kDim, K>::Wz][M];  // m q_comp (m alone without a component); z factors
+      for (int mi = 0; mi < M; ++mi) {
+        qm[mi] = kE.comp[mi] < 0 ? P.mass[p] : P.mass[p] * f.q[size_t(kE.comp[mi])];
+        for (int c = 0; c < st.Wz; ++c) v[c][mi] = pw[2][kE.e[mi][2]][c];
+      }
       for (int i = 0; i < st.W; ++i)
-        for (int j = 0; j < st.W; ++j)
-          for (int c = 0; c < st.Wz; ++c) {
-            const Real w = st.Weight(i, j, c);
-            if (w == 0) continue;
-            const int idx[3] = {i, j, c};
-            Eigen::Matrix<Real, kDim, 1> xi;
-            for (int d = 0; d < kDim; ++d) xi[d] = x_n[p][d] * ctx.inv_dx - (st.base[d] + idx[d]);
-            AddMoments<kDim, F>(&buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * M],
-                                w * P.mass[p], xi, f);
-          }
+        for (int j = 0; j < st.W; ++j) {
+          Real u[M];
+          for (int mi = 0; mi < M; ++mi) u[mi] = qm[mi] * pw[0][kE.e[mi][0]][i] * pw[1][kE.e[mi][1]][j];
+          Real* __restrict row = &buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z())) * M];
+          for (int c = 0; c < st.Wz; ++c)
+            for (int mi = 0; mi < M; ++mi) row[c * M + mi] += u[mi] * v[c][mi];
+        }
     } else {
       Vec3i cell;
       const auto xi = CellXi<kDim>(x_n[p], ctx.inv_dx, cell);
