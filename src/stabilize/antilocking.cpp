@@ -642,7 +642,8 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
       const size_t blk = run.block;
       const Vec3i origin = grid.block_origin[blk];
       // The block's padded node fits, copied once per run (as GatherBlock's halo: the same
-      // values, one neighbour lookup per node); NaN where no block is active (zero weight only).
+      // values, one neighbour lookup per node); 0 where no block is active (as an empty node:
+      // only zero weights meet them).
       thread_local std::vector<Real> halo;
       halo.resize(size_t(Pad::kSize) * Q);
       for (int a = 0; a < Pad::E; ++a)
@@ -651,8 +652,7 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
             const long g = PaddedToGrid(grid, blk, a, b, c);
             Real* h = &halo[size_t(Pad::Index(a, b, c)) * Q];
             for (int q = 0; q < Q; ++q)
-              h[q] = g < 0 ? std::numeric_limits<Real>::quiet_NaN()
-                           : s.node_fit[size_t(g) * Q + size_t(q)];
+              h[q] = g < 0 ? 0.0 : s.node_fit[size_t(g) * Q + size_t(q)];
           }
       for (uint32_t k = run.begin; k < run.end; ++k) {
         const uint32_t p = grid.sorted[k];
@@ -660,16 +660,20 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
         Stencil<kDim, K> st;
         st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
         const Vec3i lb = st.base - origin;
+        // sum_i N_ip q-hat_i axis by axis, as GatherBlock (every node: empty ones hold 0).
         F sum;
         sum.q.fill(0);
-        for (int i = 0; i < st.W; ++i)
-          for (int j = 0; j < st.W; ++j)
-            for (int c = 0; c < st.Wz; ++c) {
-              const Real w = st.Weight(i, j, c);
-              if (w == 0) continue;
-              const Real* h = &halo[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z() + c)) * Q];
-              for (int q = 0; q < Q; ++q) sum.q[q] += w * h[q];
-            }
+        for (int i = 0; i < st.W; ++i) {
+          std::array<Real, Q> sum_y{};
+          for (int j = 0; j < st.W; ++j) {
+            std::array<Real, Q> sum_z{};
+            const Real* row = &halo[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z())) * Q];
+            for (int c = 0; c < st.Wz; ++c)
+              for (int q = 0; q < Q; ++q) sum_z[size_t(q)] += st.w[2][c] * row[c * Q + q];
+            for (int q = 0; q < Q; ++q) sum_y[size_t(q)] += st.w[1][j] * sum_z[size_t(q)];
+          }
+          for (int q = 0; q < Q; ++q) sum.q[size_t(q)] += st.w[0][i] * sum_y[size_t(q)];
+        }
         hand(p, sum);
       }
     });
