@@ -122,6 +122,11 @@ void ScatterBlock(const StepContext& ctx, const Particles& P, const std::vector<
           const Real wxy = st.w[0][i] * st.w[1][j];
           const Real2 wmq = {wxy * m, wxy * mq};
           Accum* row = &buf[Pad::Index(lb.x() + i, lb.y() + j, lb.z())];
+          if constexpr (kDim == 2) {  // one node per (i, j): w_z = 1
+            row[0].w += wmq[0];
+            row[0].wq += wmq[1];
+            continue;
+          }
           for (int c = 0; c < st.Wz; ++c) {
             Real2 n;
             std::memcpy(&n, &row[c], sizeof n);
@@ -188,7 +193,11 @@ void GatherBlock(const StepContext& ctx, const Particles& P, const std::vector<V
           Real q_z = 0;
           if (use_halo) {
             const Real* row = &halo[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z()))];
-            for (int c = 0; c < st.Wz; ++c) q_z += st.w[2][c] * row[c];
+            if constexpr (kDim == 2) {
+              q_z = row[0];  // w_z = 1
+            } else {
+              for (int c = 0; c < st.Wz; ++c) q_z += st.w[2][c] * row[c];
+            }
           } else {
             for (int c = 0; c < st.Wz; ++c) {
               const long g = PaddedToGrid(grid, blk, lb.x() + i, lb.y() + j, lb.z() + c);
