@@ -32,7 +32,9 @@ enum class GhostNodes {
                     // only; separable and friction walls get the velocity mirror
   kFoldAll,         // `fold_all`: as kMirror, and separable frictionless walls fold too where the
                     // material presses on them (opt-in: removes the wall drag of flow along a
-                    // wall, but worsens node anti-locking and the floating box; docs/walls.md)
+                    // wall, but offsets node AS1's pressure; with the linear node fit it is the
+                    // settle recipe; folding walls fewer than 3 cells apart tilt a floating box;
+                    // docs/walls.md)
 };
 
 enum class WallKind {

@@ -28,6 +28,23 @@ expect check_mach_ok 0 'scene OK' -- "$surge" check "$src/scenes/dam_break_2d.ya
 if "$surge" check "$src/scenes/dam_break_2d.yaml" | grep -q Mach; then echo "FAIL check_mach_quiet: warned on the shipped dam break"; fail=$((fail + 1)); else echo "ok   check_mach_quiet"; pass=$((pass + 1)); fi
 expect check_mach_warn 0 'warning +materials\.water: .*Mach 0\.[0-9]+' -- "$surge" check "$src/scenes/dam_break_2d.yaml" --set materials.water.bulk_modulus=2.0e4
 expect check_node_stress_warn 0 "warning +body 'beam' \\(material 'aluminium'\\): stress averaging on node supports" -- "$surge" check "$src/scenes/cantilever_2d.yaml" --set 'materials.aluminium.antilocking={method: hybrid, stress: true}'
+cat > "$work/thin_slab.yaml" <<'YAML'
+name: thin_slab
+dimension: 3
+time: {end: 0.1}
+grid: {cell_size: 0.02}
+domain:
+  min: [0, 0, 0]
+  max: [0.6, 0.4, 0.04]
+  walls: {x-: slip, x+: slip, y-: slip, z-: slip, z+: slip}
+  ghost_nodes: fold_all
+materials:
+  water: {model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e5, viscosity: 0.001}
+bodies:
+  - {name: water, material: water, region: {box: {min: [0, 0, 0], max: [0.6, 0.16, 0.04]}}}
+YAML
+expect check_fold_all_thin_slab_warn 0 'warning +domain\.ghost_nodes: fold_all with the walls z- and z\+ only 2 cells apart' -- "$surge" check "$work/thin_slab.yaml"
+if "$surge" check "$src/scenes/tank_drain_2d.yaml" 2>&1 | grep -q "fold_all with the walls"; then echo "FAIL check_fold_all_quiet: warned on the shipped tank drain"; fail=$((fail + 1)); else echo "ok   check_fold_all_quiet"; pass=$((pass + 1)); fi
 expect check_cutoff_above_apex_warn 0 'warning +materials\.sand: tension_cutoff 1000 Pa is at or above the apex' -- "$surge" check "$src/scenes/geostatic_column_2d.yaml" --set materials.sand.tension_cutoff=1000
 expect check_mach_warn_bingham 0 'warning +materials\.mud: .*Mach' -- "$surge" check "$src/scenes/mudflow_2d.yaml" --set materials.mud.bulk_modulus=1.0e3
 expect info_lists_models 0 'materials: .*j2.*newtonian_fluid' -- "$surge" info
