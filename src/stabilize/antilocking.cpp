@@ -440,9 +440,10 @@ Mat3 ProjectedIncrement(const Mat3& f, const Mat3& eps_h, const Mat3& inv_stretc
 }
 
 // Adds one particle's weighted moments (weight w at position xi, components f) to the sums `a`
-// (layout of Filtered::kMoments).
+// (layout of Filtered::kMoments). The cell-based scatter's; the node-based one forms the same
+// moments as products of per-axis factors (ScatterMoments, MomentExponents).
 template <int kDim, class F>
-[[gnu::always_inline]] inline void AddMoments(Real* a, Real w, const Eigen::Matrix<Real, kDim, 1>& xi, const F& f) {
+void AddMoments(Real* a, Real w, const Eigen::Matrix<Real, kDim, 1>& xi, const F& f) {
   int j = 0;
   a[j++] += w;
   for (int d = 0; d < kDim; ++d) a[j++] += w * xi[d];
@@ -526,7 +527,7 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
     if constexpr (kNode) {
       // The node moments separate along the axes: with N_ip = w_x w_y w_z and xi = (x_p - x_i)/dx,
       // every moment of AddMoments is m q^(0|1) prod_d w_d xi_d^e_d (MomentExponents), formed as
-      // a per-(i, j) factor U times a per-z-node factor V: M multiply-adds per node, in lanes.
+      // a per-(i, j) factor u times a per-z-node factor v: M multiply-adds per node.
       constexpr MomentExponents<kDim, F> kE{};
       Stencil<kDim, K> st;
       st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
@@ -547,7 +548,8 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
       for (int i = 0; i < st.W; ++i)
         for (int j = 0; j < st.W; ++j) {
           Real u[M];
-          for (int mi = 0; mi < M; ++mi) u[mi] = qm[mi] * pw[0][kE.e[mi][0]][i] * pw[1][kE.e[mi][1]][j];
+          for (int mi = 0; mi < M; ++mi)
+            u[mi] = qm[mi] * pw[0][kE.e[mi][0]][i] * pw[1][kE.e[mi][1]][j];
           Real* __restrict row = &buf[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z())) * M];
           for (int c = 0; c < st.Wz; ++c)
             for (int mi = 0; mi < M; ++mi) row[c * M + mi] += u[mi] * v[c][mi];

@@ -202,14 +202,15 @@ TEST(RigidCouplingTest, LightBoxFloatsInForceBalanceWithTheKnownLidForceDeficit)
 }
 
 // Folded ghost nodes (`domain.ghost_nodes: fold_all`, docs/walls.md) at the tank's frictionless
-// walls, in a slab three cells thick: the box floats 1.6 % below its Archimedes draft instead
-// of the mirror's 4.2 %, upright and in force balance. Measured 2026-12-07 by hand (draft below
+// walls, in a slab three cells thick: the box floats 1.6 % deeper than its Archimedes draft
+// instead of the mirror's 4.2 %, upright and in force balance. Measured 2026-12-07 by hand (draft below
 // the open water, averaged over 1.5-2 s; mirror / fold_all): h = 0.02 m, slab 3 / 4 / 6 cells
 // +4.18 / +4.87 / +4.18 % against +1.58 / +1.37 / +1.31 %; h = 0.015 m +2.55 against +0.32 %;
 // h = 0.0125 m +9.3 against +7.4 % (both tilt by 0.045 rad: the staircase of
 // LightBoxFloats... is still there); h = 0.01 m +4.08 against +1.65 %. So fold_all takes about
-// 2.5 points off the draft error at every resolution, and within 3 % at three of the four. In the default slab of two cells the fold of both z walls lands on the middle
-// node plane and the box tilts (+11.5 %, 0.022 rad), which made fold_all look worse before.
+// 2.5 points off the draft error at every resolution, and within 3 % at three of the four.
+// In the default slab of two cells the fold of both z walls lands on the middle node plane and
+// the box tilts (+11.5 %, 0.022 rad), which made fold_all look worse before.
 TEST(RigidCouplingTest, FoldedGhostNodesFloatTheBoxWithinThreePercentAtThisResolution) {
   Tank mirror, folded;
   mirror.slab_cells = folded.slab_cells = 3;
