@@ -4,8 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
+#include "core/simd.h"
 #include "materials/hencky.h"
+
+#if SURGE_HAVE_WIDE_SIMD
+#include <immintrin.h>  // _mm256_zeroupper (the wide return)
+#endif
 
 namespace surge {
 namespace {
@@ -92,14 +99,101 @@ int SmoothCapReturn(const SmoothCapDruckerPragerParams& p, const Vec3& tau_trial
   return 3;
 }
 
-void PlasticUpdate(const SmoothCapDruckerPragerParams& p, const Mat3& f, Real J, Mat3& elastic_b,
-                   History& h, Mat3& stress) {
-  const HenckyTrial t = HenckyTrialState(p.bulk_modulus, p.shear_modulus, f, elastic_b);
-  PlasticUpdate(p, f, t, J, elastic_b, h, stress);
+namespace {
+
+// Four trial states for PlasticUpdate4, lane-major ([component][lane]), and what the lane return
+// made of them: the returned principal stresses (in place), the region (0 elastic, 1 cone, -1
+// left to SmoothCapReturn) and the cone return's increments of the two plastic-strain sums.
+struct ReturnGroup {
+  alignas(32) Real tau[3][4];
+  alignas(32) Real eps[3][4];
+  alignas(32) Real region[4];
+  alignas(32) Real d_strain[4];
+  alignas(32) Real d_volume[4];
+};
+
+// The material constants of the lane return, each computed by the same expression as in
+// SmoothCapReturn and PlasticUpdate, so each lane's result is bitwise theirs.
+struct ConeConstants {
+  Real K, G;
+  Real rho_f, yield_stress;
+  Real radius, I1_tangent;  // the cap's R_t and I_t (CapOf)
+  Real denominator;         // 2G + 9K varrho_F varrho_G
+  Real volume_factor;       // 9K varrho_G
+};
+
+ConeConstants ConeConstantsOf(const SmoothCapDruckerPragerParams& p) {
+  const Real K = p.bulk_modulus, G = p.shear_modulus;
+  const Real rho_f = p.friction_slope, rho_g = p.associativity * p.friction_slope;
+  const Cap cap = CapOf(p);
+  return {K, G, rho_f, p.yield_stress, cap.radius, cap.I1_tangent,
+          2.0 * G + 9.0 * K * rho_f * rho_g, 9.0 * K * rho_g};
 }
 
-void PlasticUpdate(const SmoothCapDruckerPragerParams& p, const Mat3&, const HenckyTrial& t,
-                   Real J, Mat3& elastic_b, History& h, Mat3& stress) {
+using Mask4 = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
+
+[[gnu::always_inline]] inline Real4 Load4(const Real* p) {
+  Real4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+[[gnu::always_inline]] inline void Store4(Real* p, Real4 v) { std::memcpy(p, &v, sizeof v); }
+[[gnu::always_inline]] inline Real4 Splat4(Real a) { return Real4{a, a, a, a}; }
+[[gnu::always_inline]] inline Real4 Sqrt4(Real4 a) {
+  return Real4{__builtin_sqrt(a[0]), __builtin_sqrt(a[1]), __builtin_sqrt(a[2]),
+               __builtin_sqrt(a[3])};
+}
+
+// SmoothCapReturn's yield test and cone return, and PlasticUpdate's plastic-strain increments,
+// for four trial states in the lanes, each operation as the scalar code orders it. A lane that
+// the cone does not take (cap, ring, or a non-finite trial) is marked -1 and left unchanged.
+[[gnu::always_inline]] inline void ReturnLanes(const ConeConstants& c, ReturnGroup& g) {
+  const Real4 a0 = Load4(g.tau[0]), a1 = Load4(g.tau[1]), a2 = Load4(g.tau[2]);
+  const Real4 I1 = (a0 + a1) + a2, mean = I1 / 3.0;
+  const Real4 s0 = a0 - mean, s1 = a1 - mean, s2 = a2 - mean;
+  const Real4 s_norm = Sqrt4((s0 * s0 + s1 * s1) + s2 * s2);
+  const Real4 I_t = Splat4(c.I1_tangent), zero = Splat4(0.0);
+  const Real4 F1 = (s_norm + c.rho_f * I1) - c.yield_stress;                 // F1 (3.101)
+  const Real4 F2 = Sqrt4(s_norm * s_norm + I1 * I1 / 3.0) - c.radius;         // F2
+  const Mask4 elastic = (I1 <= I_t ? F1 : F2) <= zero;
+  // Cone return (3.88)-(3.91): dgamma = F1 / (2G + 9K varrho_F varrho_G).
+  const Real4 dgamma = F1 / c.denominator;
+  const Real4 I1_new = I1 - c.volume_factor * dgamma;  // (3.89)
+  const Real4 shrink = (2.0 * c.G) * dgamma;
+  const Mask4 cone = ~elastic & (F1 > zero) & (s_norm - shrink >= zero) & (I1_new <= I_t);
+  const Real4 factor = 1.0 - shrink / s_norm, mean_new = I1_new / 3.0;
+  const Real4 r0 = s0 * factor + mean_new, r1 = s1 * factor + mean_new;
+  const Real4 r2 = s2 * factor + mean_new;
+  Store4(g.tau[0], cone ? r0 : a0);
+  Store4(g.tau[1], cone ? r1 : a1);
+  Store4(g.tau[2], cone ? r2 : a2);
+  // eps_tr - [D^e_d] tau (HenckyStrain, (3.47)): the plastic increment in principal space.
+  const Real4 tr = (r0 + r1) + r2, vol = tr / (9.0 * c.K), third = tr / 3.0;
+  const Real g2 = 2.0 * c.G;
+  const Real4 d0 = Load4(g.eps[0]) - (vol + (r0 - third) / g2);
+  const Real4 d1 = Load4(g.eps[1]) - (vol + (r1 - third) / g2);
+  const Real4 d2 = Load4(g.eps[2]) - (vol + (r2 - third) / g2);
+  const Real4 d_sum = (d0 + d1) + d2, d_mean = d_sum / 3.0;
+  const Real4 e0 = d0 - d_mean, e1 = d1 - d_mean, e2 = d2 - d_mean;
+  Store4(g.d_strain, Sqrt4((e0 * e0 + e1 * e1) + e2 * e2));
+  Store4(g.d_volume, d_sum);
+  Store4(g.region, elastic ? zero : (cone ? Splat4(1.0) : Splat4(-1.0)));
+}
+
+void ReturnPortable(const ConeConstants& c, ReturnGroup& g) { ReturnLanes(c, g); }
+
+#if SURGE_HAVE_WIDE_SIMD
+SURGE_TARGET_WIDE void ReturnWide(const ConeConstants& c, ReturnGroup& g) {
+  ReturnLanes(c, g);
+#if !defined(__clang__)
+  _mm256_zeroupper();  // GCC 12 leaves the upper halves dirty (see SymmetricEigen4)
+#endif
+}
+#endif
+
+// PlasticUpdate's body after the trial state (Table 3.4, steps 5-6).
+void UpdateFromTrial(const SmoothCapDruckerPragerParams& p, const HenckyTrial& t, Real J,
+                     Mat3& elastic_b, History& h, Mat3& stress) {
   const Real K = p.bulk_modulus, G = p.shear_modulus;  // t: Table 3.4, steps 1-4
   Vec3 tau;
   const int region = SmoothCapReturn(p, t.tau, tau);
@@ -111,6 +205,52 @@ void PlasticUpdate(const SmoothCapDruckerPragerParams& p, const Mat3&, const Hen
     h[kScdpPlasticVolume] += dep.sum();
   }
   HenckyFinish(t, K, G, tau, J, elastic_b, stress);  // Table 3.4, 5(c)-(d)
+}
+
+}  // namespace
+
+void PlasticUpdate(const SmoothCapDruckerPragerParams& p, const Mat3& f, Real J, Mat3& elastic_b,
+                   History& h, Mat3& stress) {
+  const HenckyTrial t = HenckyTrialState(p.bulk_modulus, p.shear_modulus, f, elastic_b);
+  PlasticUpdate(p, f, t, J, elastic_b, h, stress);
+}
+
+void PlasticUpdate(const SmoothCapDruckerPragerParams& p, const Mat3&, const HenckyTrial& t,
+                   Real J, Mat3& elastic_b, History& h, Mat3& stress) {
+  UpdateFromTrial(p, t, J, elastic_b, h, stress);
+}
+
+void PlasticUpdate4(const SmoothCapDruckerPragerParams& p, const HenckyTrial* t, const Real* J,
+                    Mat3* elastic_b, History* h, Mat3* stress) {
+  ReturnGroup g;
+  for (int k = 0; k < 4; ++k)
+    for (int i = 0; i < 3; ++i) {
+      g.tau[i][k] = t[k].tau(i);
+      g.eps[i][k] = t[k].eps(i);
+    }
+  const ConeConstants c = ConeConstantsOf(p);
+#if SURGE_HAVE_WIDE_SIMD
+  WideSimd() ? ReturnWide(c, g) : ReturnPortable(c, g);
+#else
+  ReturnPortable(c, g);
+#endif
+  Vec3 tau[4];
+  unsigned lanes = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int region = int(g.region[k]);
+    if (region < 0) {  // the cap, the ring, or a non-finite trial: the scalar return
+      UpdateFromTrial(p, t[k], J[k], elastic_b[k], h[k], stress[k]);
+      continue;
+    }
+    h[k][kScdpRegion] = region;
+    if (region != 0) {
+      h[k][kScdpPlasticStrain] += g.d_strain[k];
+      h[k][kScdpPlasticVolume] += g.d_volume[k];
+    }
+    tau[k] = Vec3(g.tau[0][k], g.tau[1][k], g.tau[2][k]);
+    lanes |= 1u << k;
+  }
+  HenckyFinish4(t, p.bulk_modulus, p.shear_modulus, tau, J, lanes, elastic_b, stress);
 }
 
 }  // namespace surge

@@ -29,6 +29,13 @@ void PlasticUpdate(const SmoothCapDruckerPragerParams& params, const Mat3& f, Re
 void PlasticUpdate(const SmoothCapDruckerPragerParams& params, const Mat3& f, const HenckyTrial& t,
                    Real J, Mat3& elastic_b, History& history, Mat3& stress);
 
+// The same for four particles (t[k], J[k], elastic_b[k], history[k], stress[k]), each bitwise
+// what the one above gives: the yield test, the cone return and the finish run in four lanes
+// (AVX where WideSimd(), core/simd.h); a particle the cone does not take (cap or ring) returns
+// through the scalar code.
+void PlasticUpdate4(const SmoothCapDruckerPragerParams& params, const HenckyTrial* t, const Real* J,
+                    Mat3* elastic_b, History* history, Mat3* stress);
+
 // Principal-space return of a trial Kirchhoff stress (exposed for tests). Returns the region
 // (0 elastic, 1 cone, 2 cap, 3 tangent ring) and writes the returned principal stresses.
 int SmoothCapReturn(const SmoothCapDruckerPragerParams& params, const Vec3& tau_trial, Vec3& tau);

@@ -110,16 +110,27 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
             t[i] = HenckyTrialState(K, G, f[i], b[i]);
         }
       }
+      Mat3 stress[4];
+      History h[4];
+      Real J[4];
       for (size_t i = 0; i < n; ++i) {
-        Mat3 stress;
-        History h = P.history.Get(p[i]);  // the run's slots, the rest zero
-        const Real J = Det3(P.F[p[i]]);
-        PlasticUpdate(params, f[i], t[i], J, b[i], h, stress);
-        P.history.Set(p[i], h);
+        h[i] = P.history.Get(p[i]);  // the run's slots, the rest zero
+        J[i] = Det3(P.F[p[i]]);
+      }
+      bool lanes = false;  // the return and finish four lanes wide, each lane bitwise the below
+      if constexpr (requires { PlasticUpdate4(params, t, J, b, h, stress); }) {
+        lanes = n == 4;
+        if (lanes) PlasticUpdate4(params, t, J, b, h, stress);
+      }
+      if (!lanes)
+        for (size_t i = 0; i < n; ++i)
+          PlasticUpdate(params, f[i], t[i], J[i], b[i], h[i], stress[i]);
+      for (size_t i = 0; i < n; ++i) {
+        P.history.Set(p[i], h[i]);
         P.elastic_b[p[i]] = b[i];
-        P.stress[p[i]] = stress;
-        if (energy) sum += before[i] + power_of(p[i], grad(k0 + i), J);
-        if (checks) checks->Test(P, p[i], J);
+        P.stress[p[i]] = stress[i];
+        if (energy) sum += before[i] + power_of(p[i], grad(k0 + i), J[i]);
+        if (checks) checks->Test(P, p[i], J[i]);
       }
     }
   } else {
