@@ -2,14 +2,8 @@
 #include "materials/hencky.h"
 
 #include <cmath>
-#include <cstring>
 
-#include "core/simd.h"
 #include "materials/symmetric_eigen.h"
-
-#if SURGE_HAVE_WIDE_SIMD
-#include <immintrin.h>  // _mm256_zeroupper (the wide finish)
-#endif
 
 namespace surge {
 
@@ -66,135 +60,6 @@ void HenckyTrialStates4(Real K, Real G, const Mat3* f, const Mat3* elastic_b, He
   for (int k = 0; k < 4; ++k) {
     t[k].Q = Q[k];
     TrialFromPrincipal(K, G, principal[k], t[k]);
-  }
-}
-
-namespace {
-
-// A group of four particles for HenckyFinish4, lane-major ([component][lane]): its inputs, the
-// principal values 2 eps_e (then exp(2 eps_e) in place) and the two tensors' distinct entries in
-// the order 00 01 02 11 12 22.
-struct FinishGroup {
-  alignas(32) Real tau[3][4];
-  alignas(32) Real q[9][4];  // Q(r, c) at [3 r + c]
-  alignas(32) Real J[4];
-  alignas(32) Real x[3][4];
-  alignas(32) Real b[6][4];
-  alignas(32) Real s[6][4];
-};
-
-[[gnu::always_inline]] inline Real4 Load4(const Real* p) {
-  Real4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-[[gnu::always_inline]] inline void Store4(Real* p, Real4 v) { std::memcpy(p, &v, sizeof v); }
-
-// eps_e = [D^e_d] tau (HenckyStrain, (3.47)) and x = 2 eps_e, lane-wise in HenckyStrain's order.
-[[gnu::always_inline]] inline void StrainLanes(Real K, Real G, FinishGroup& g) {
-  const Real4 a0 = Load4(g.tau[0]), a1 = Load4(g.tau[1]), a2 = Load4(g.tau[2]);
-  const Real4 tr = (a0 + a1) + a2, vol = tr / (9.0 * K), third = tr / 3.0;
-  const Real g2 = 2.0 * G;
-  Store4(g.x[0], 2.0 * (vol + (a0 - third) / g2));
-  Store4(g.x[1], 2.0 * (vol + (a1 - third) / g2));
-  Store4(g.x[2], 2.0 * (vol + (a2 - third) / g2));
-}
-
-// Q diag(v) Q^T's distinct entries, lane-wise in FromPrincipal's order.
-[[gnu::always_inline]] inline void FromPrincipalLanes(const Real4 (&q)[9], const Real4 (&v)[3],
-                                                      Real4 (&m)[6]) {
-  Real4 r0[3], r1[3], r2[3];
-  for (int k = 0; k < 3; ++k) {
-    r0[k] = q[k] * v[k];
-    r1[k] = q[3 + k] * v[k];
-    r2[k] = q[6 + k] * v[k];
-  }
-  m[0] = (r0[0] * q[0] + r0[1] * q[1]) + r0[2] * q[2];
-  m[1] = (r0[0] * q[3] + r0[1] * q[4]) + r0[2] * q[5];
-  m[2] = (r0[0] * q[6] + r0[1] * q[7]) + r0[2] * q[8];
-  m[3] = (r1[0] * q[3] + r1[1] * q[4]) + r1[2] * q[5];
-  m[4] = (r1[0] * q[6] + r1[1] * q[7]) + r1[2] * q[8];
-  m[5] = r2[0] * q[6] + (r2[1] * q[7] + r2[2] * q[8]);  // Eigen's split sum of an expression
-}
-
-// b^e = Q diag(x) Q^T and sigma = Q diag(tau) Q^T / J (Table 3.4, 5(c)-(d), (3.37)).
-[[gnu::always_inline]] inline void TensorLanes(FinishGroup& g) {
-  Real4 q[9], v[3], m[6];
-  for (int k = 0; k < 9; ++k) q[k] = Load4(g.q[k]);
-  for (int k = 0; k < 3; ++k) v[k] = Load4(g.x[k]);
-  FromPrincipalLanes(q, v, m);
-  for (int k = 0; k < 6; ++k) Store4(g.b[k], m[k]);
-  for (int k = 0; k < 3; ++k) v[k] = Load4(g.tau[k]);
-  FromPrincipalLanes(q, v, m);
-  const Real4 J = Load4(g.J);
-  for (int k = 0; k < 6; ++k) Store4(g.s[k], m[k] / J);
-}
-
-void StrainPortable(Real K, Real G, FinishGroup& g) { StrainLanes(K, G, g); }
-void TensorPortable(FinishGroup& g) { TensorLanes(g); }
-
-#if SURGE_HAVE_WIDE_SIMD
-// The AVX builds; each clears the upper register halves before it returns to SSE code (GCC 12
-// does not, see SymmetricEigen4).
-SURGE_TARGET_WIDE void StrainWide(Real K, Real G, FinishGroup& g) {
-  StrainLanes(K, G, g);
-#if !defined(__clang__)
-  _mm256_zeroupper();
-#endif
-}
-SURGE_TARGET_WIDE void TensorWide(FinishGroup& g) {
-  TensorLanes(g);
-#if !defined(__clang__)
-  _mm256_zeroupper();
-#endif
-}
-#endif
-
-// The 6 distinct entries (00 01 02 11 12 22) of lane k as a symmetric matrix.
-Mat3 SymmetricOf(const Real (&m)[6][4], int k) {
-  Mat3 a;
-  a << m[0][k], m[1][k], m[2][k],  //
-      m[1][k], m[3][k], m[4][k],   //
-      m[2][k], m[4][k], m[5][k];
-  return a;
-}
-
-}  // namespace
-
-void HenckyFinish4(const HenckyTrial* t, Real K, Real G, const Vec3* tau, const Real* J,
-                   unsigned lanes, Mat3* elastic_b, Mat3* stress) {
-  FinishGroup g;
-  bool elastic[4];
-  for (int k = 0; k < 4; ++k) {
-    const bool on = lanes & (1u << k);
-    const Vec3& tk = on ? tau[k] : t[k].tau;  // an unused lane computes on finite values
-    elastic[k] = tk == t[k].tau;
-    for (int i = 0; i < 3; ++i) g.tau[i][k] = tk(i);
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) g.q[3 * r + c][k] = t[k].Q(r, c);
-    g.J[k] = on ? J[k] : 1.0;
-  }
-#if SURGE_HAVE_WIDE_SIMD
-  const bool wide = WideSimd();
-  wide ? StrainWide(K, G, g) : StrainPortable(K, G, g);
-#else
-  StrainPortable(K, G, g);
-#endif
-  for (int k = 0; k < 4; ++k) {  // Table 3.4, 5(c): b^e principal values exp(2 eps_e)
-    if (elastic[k]) continue;
-    // Through Eigen's array exp, as HenckyFinish: it takes a pair of the three in a packet.
-    const Vec3 v = Vec3(g.x[0][k], g.x[1][k], g.x[2][k]).array().exp().matrix();
-    for (int i = 0; i < 3; ++i) g.x[i][k] = v(i);
-  }
-#if SURGE_HAVE_WIDE_SIMD
-  wide ? TensorWide(g) : TensorPortable(g);
-#else
-  TensorPortable(g);
-#endif
-  for (int k = 0; k < 4; ++k) {
-    if (!(lanes & (1u << k))) continue;
-    elastic_b[k] = elastic[k] ? t[k].b : SymmetricOf(g.b, k);  // elastic: b^e_tr, as HenckyFinish
-    stress[k] = SymmetricOf(g.s, k);
   }
 }
 

@@ -50,13 +50,6 @@ void HenckyTrialStates4(Real K, Real G, const Mat3* f, const Mat3* elastic_b, He
 inline void HenckyFinish(const HenckyTrial& trial, Real K, Real G, const Vec3& tau, Real J,
                          Mat3& elastic_b, Mat3& stress);
 
-// HenckyFinish for the four particles of a lane group: lane k (bit k of `lanes` set) writes
-// elastic_b[k] and stress[k] from t[k], tau[k] and J[k], bitwise what HenckyFinish gives; lanes
-// whose bit is clear are left alone. The divisions and products run four lanes wide (the AVX
-// build where WideSimd(), core/simd.h), the exponentials lane by lane.
-void HenckyFinish4(const HenckyTrial* t, Real K, Real G, const Vec3* tau, const Real* J,
-                   unsigned lanes, Mat3* elastic_b, Mat3* stress);
-
 // Elastic b^e for a Kirchhoff stress: eps_e = D^e : tau (3.47), b^e = exp(2 eps_e) (4.40).
 // Used for a prescribed (geostatic) initial stress at F = I, where tau = sigma.
 Mat3 ElasticBFromStress(Real K, Real G, const Mat3& tau);

@@ -250,7 +250,11 @@ void PlasticUpdate4(const SmoothCapDruckerPragerParams& p, const HenckyTrial* t,
     tau[k] = Vec3(g.tau[0][k], g.tau[1][k], g.tau[2][k]);
     lanes |= 1u << k;
   }
-  HenckyFinish4(t, p.bulk_modulus, p.shear_modulus, tau, J, lanes, elastic_b, stress);
+  // Table 3.4, 5(c)-(d) lane by lane: a four-lane finish (tried) was no faster, its exponentials
+  // and transpositions being most of its work.
+  for (int k = 0; k < 4; ++k)
+    if (lanes & (1u << k))
+      HenckyFinish(t[k], p.bulk_modulus, p.shear_modulus, tau[k], J[k], elastic_b[k], stress[k]);
 }
 
 }  // namespace surge
