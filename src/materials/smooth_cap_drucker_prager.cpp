@@ -102,8 +102,8 @@ int SmoothCapReturn(const SmoothCapDruckerPragerParams& p, const Vec3& tau_trial
 namespace {
 
 // Four trial states for PlasticUpdate4, lane-major ([component][lane]), and what the lane return
-// made of them: the returned principal stresses (in place), the region (0 elastic, 1 cone, -1
-// left to SmoothCapReturn) and the cone return's increments of the two plastic-strain sums.
+// made of them: the returned principal stresses (in place), the region (0 elastic, 1 cone, 2 cap,
+// 3 ring, -1 left to SmoothCapReturn) and the increments of the two plastic-strain sums.
 struct ReturnGroup {
   alignas(32) Real tau[3][4];
   alignas(32) Real eps[3][4];
@@ -117,17 +117,26 @@ struct ReturnGroup {
 struct ConeConstants {
   Real K, G;
   Real rho_f, yield_stress;
-  Real radius, I1_tangent;  // the cap's R_t and I_t (CapOf)
-  Real denominator;         // 2G + 9K varrho_F varrho_G
-  Real volume_factor;       // 9K varrho_G
+  Real radius, I1_tangent, s_tangent;  // the cap's R_t, I_t and ||s||_t (CapOf)
+  Real denominator;                    // 2G + 9K varrho_F varrho_G
+  Real volume_factor;                  // 9K varrho_G
+  Real radius_sqrt3;                   // sqrt(3) R_t
 };
 
 ConeConstants ConeConstantsOf(const SmoothCapDruckerPragerParams& p) {
   const Real K = p.bulk_modulus, G = p.shear_modulus;
   const Real rho_f = p.friction_slope, rho_g = p.associativity * p.friction_slope;
   const Cap cap = CapOf(p);
-  return {K, G, rho_f, p.yield_stress, cap.radius, cap.I1_tangent,
-          2.0 * G + 9.0 * K * rho_f * rho_g, 9.0 * K * rho_g};
+  return {K,
+          G,
+          rho_f,
+          p.yield_stress,
+          cap.radius,
+          cap.I1_tangent,
+          cap.s_tangent,
+          2.0 * G + 9.0 * K * rho_f * rho_g,
+          9.0 * K * rho_g,
+          std::sqrt(3.0) * cap.radius};
 }
 
 using Mask4 = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
@@ -145,8 +154,9 @@ using Mask4 = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
 }
 
 // SmoothCapReturn's yield test and cone return, and PlasticUpdate's plastic-strain increments,
-// for four trial states in the lanes, each operation as the scalar code orders it. A lane that
-// the cone does not take (cap, ring, or a non-finite trial) is marked -1 and left unchanged.
+// for four trial states in the lanes, each operation as the scalar code orders it: the elastic
+// test, the cone, and for the lanes the cone does not take the cap's Newton iteration and the
+// tangent ring. A lane with a non-finite trial is marked -1 and left unchanged.
 [[gnu::always_inline]] inline void ReturnLanes(const ConeConstants& c, ReturnGroup& g) {
   const Real4 a0 = Load4(g.tau[0]), a1 = Load4(g.tau[1]), a2 = Load4(g.tau[2]);
   const Real4 I1 = (a0 + a1) + a2, mean = I1 / 3.0;
@@ -162,11 +172,52 @@ using Mask4 = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
   const Real4 shrink = (2.0 * c.G) * dgamma;
   const Mask4 cone = ~elastic & (F1 > zero) & (s_norm - shrink >= zero) & (I1_new <= I_t);
   const Real4 factor = 1.0 - shrink / s_norm, mean_new = I1_new / 3.0;
-  const Real4 r0 = s0 * factor + mean_new, r1 = s1 * factor + mean_new;
-  const Real4 r2 = s2 * factor + mean_new;
-  Store4(g.tau[0], cone ? r0 : a0);
-  Store4(g.tau[1], cone ? r1 : a1);
-  Store4(g.tau[2], cone ? r2 : a2);
+  Real4 r0 = s0 * factor + mean_new, r1 = s1 * factor + mean_new;
+  Real4 r2 = s2 * factor + mean_new;
+  // The cap and the ring for the finite lanes that neither test took (SmoothCapReturn's scalar
+  // Newton on x = dgamma / R_t, each lane iterating until its own test stops it).
+  const Mask4 finite = ((I1 - I1) == zero) & ((s_norm - s_norm) == zero);
+  const Mask4 rest = ~elastic & ~cone & finite;
+  Mask4 on_cap = rest & 0;
+  if (rest[0] | rest[1] | rest[2] | rest[3]) {
+    const Real g2 = 2.0 * c.G, k3 = 3.0 * c.K;
+    const Real4 abs_I1 = I1 < zero ? -I1 : I1;  // std::abs
+    const Real4 x_s = (s_norm / c.radius - 1.0) / g2, x_I = (abs_I1 / c.radius_sqrt3 - 1.0) / k3;
+    Real4 x = zero;  // std::max({0, x_s, x_I}): the first largest
+    x = x < x_s ? x_s : x;
+    x = x < x_I ? x_I : x;
+    Mask4 active = rest;
+    const Real4 sn2 = s_norm * s_norm, I12 = I1 * I1;
+    for (int it = 0; it < 100 && (active[0] | active[1] | active[2] | active[3]); ++it) {
+      const Real4 a = 1.0 + g2 * x, b = 1.0 + k3 * x;
+      const Real4 phi = (sn2 / (a * a) + I12 / ((3.0 * b) * b)) - c.radius * c.radius;
+      const Real4 dphi = (-4.0 * c.G) * s_norm * s_norm / ((a * a) * a) -
+                         (2.0 * c.K) * I1 * I1 / ((b * b) * b);
+      active &= ~(dphi >= zero);
+      const Real4 step = -phi / dphi;
+      x = active ? x + step : x;
+      const Real4 abs_step = step < zero ? -step : step;
+      const Real4 floor = x < 1e-300 ? Splat4(1e-300) : x;  // std::max(x, 1e-300)
+      active &= ~(abs_step <= 1e-15 * floor);
+    }
+    const Real4 I1_cap = I1 / (1.0 + k3 * x);
+    on_cap = rest & (I1_cap >= I_t);
+    const Real4 d = 1.0 + g2 * x;
+    const Real4 scale = c.radius / Sqrt4(sn2 / (d * d) + I1_cap * I1_cap / 3.0);
+    const Real4 mean_cap = I1_cap / 3.0;
+    // The tangent ring (I1 = I_t, ||s|| = ||s||_t) in the direction of s_tr.
+    const Real4 mean_t = Splat4(c.I1_tangent / 3.0);
+    const Mask4 has_s = s_norm > zero;
+    const Real4 n0 = has_s ? s0 / s_norm : zero, n1 = has_s ? s1 / s_norm : zero;
+    const Real4 n2 = has_s ? s2 / s_norm : zero;
+    r0 = rest ? (on_cap ? (s0 / d + mean_cap) * scale : c.s_tangent * n0 + mean_t) : r0;
+    r1 = rest ? (on_cap ? (s1 / d + mean_cap) * scale : c.s_tangent * n1 + mean_t) : r1;
+    r2 = rest ? (on_cap ? (s2 / d + mean_cap) * scale : c.s_tangent * n2 + mean_t) : r2;
+  }
+  const Mask4 plastic = cone | rest;
+  Store4(g.tau[0], plastic ? r0 : a0);
+  Store4(g.tau[1], plastic ? r1 : a1);
+  Store4(g.tau[2], plastic ? r2 : a2);
   // eps_tr - [D^e_d] tau (HenckyStrain, (3.47)): the plastic increment in principal space.
   const Real4 tr = (r0 + r1) + r2, vol = tr / (9.0 * c.K), third = tr / 3.0;
   const Real g2 = 2.0 * c.G;
@@ -177,7 +228,8 @@ using Mask4 = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
   const Real4 e0 = d0 - d_mean, e1 = d1 - d_mean, e2 = d2 - d_mean;
   Store4(g.d_strain, Sqrt4((e0 * e0 + e1 * e1) + e2 * e2));
   Store4(g.d_volume, d_sum);
-  Store4(g.region, elastic ? zero : (cone ? Splat4(1.0) : Splat4(-1.0)));
+  const Real4 other = rest ? (on_cap ? Splat4(2.0) : Splat4(3.0)) : Splat4(-1.0);
+  Store4(g.region, elastic ? zero : (cone ? Splat4(1.0) : other));
 }
 
 void ReturnPortable(const ConeConstants& c, ReturnGroup& g) { ReturnLanes(c, g); }
@@ -238,7 +290,7 @@ void PlasticUpdate4(const SmoothCapDruckerPragerParams& p, const HenckyTrial* t,
   unsigned lanes = 0;
   for (int k = 0; k < 4; ++k) {
     const int region = int(g.region[k]);
-    if (region < 0) {  // the cap, the ring, or a non-finite trial: the scalar return
+    if (region < 0) {  // a non-finite trial: the scalar return
       UpdateFromTrial(p, t[k], J[k], elastic_b[k], h[k], stress[k]);
       continue;
     }

@@ -30,9 +30,9 @@ void PlasticUpdate(const SmoothCapDruckerPragerParams& params, const Mat3& f, co
                    Real J, Mat3& elastic_b, History& history, Mat3& stress);
 
 // The same for four particles (t[k], J[k], elastic_b[k], history[k], stress[k]), each bitwise
-// what the one above gives: the yield test, the cone return and the plastic-strain increments run
-// in four lanes (AVX where WideSimd(), core/simd.h); a particle the cone does not take (cap or
-// ring) returns through the scalar code.
+// what the one above gives: the yield test, the cone, cap and ring returns and the plastic-strain
+// increments run in four lanes (AVX where WideSimd(), core/simd.h); a particle with a non-finite
+// trial stress returns through the scalar code.
 void PlasticUpdate4(const SmoothCapDruckerPragerParams& params, const HenckyTrial* t, const Real* J,
                     Mat3* elastic_b, History* history, Mat3* stress);
 
