@@ -114,7 +114,7 @@ struct ReturnGroup {
 
 // The material constants of the lane return, each computed by the same expression as in
 // SmoothCapReturn and PlasticUpdate, so each lane's result is bitwise theirs.
-struct ConeConstants {
+struct LaneConstants {
   Real K, G;
   Real rho_f, yield_stress;
   Real radius, I1_tangent, s_tangent;  // the cap's R_t, I_t and ||s||_t (CapOf)
@@ -123,7 +123,7 @@ struct ConeConstants {
   Real radius_sqrt3;                   // sqrt(3) R_t
 };
 
-ConeConstants ConeConstantsOf(const SmoothCapDruckerPragerParams& p) {
+LaneConstants LaneConstantsOf(const SmoothCapDruckerPragerParams& p) {
   const Real K = p.bulk_modulus, G = p.shear_modulus;
   const Real rho_f = p.friction_slope, rho_g = p.associativity * p.friction_slope;
   const Cap cap = CapOf(p);
@@ -153,11 +153,10 @@ using Mask4 = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
                __builtin_sqrt(a[3])};
 }
 
-// SmoothCapReturn's yield test and cone return, and PlasticUpdate's plastic-strain increments,
-// for four trial states in the lanes, each operation as the scalar code orders it: the elastic
-// test, the cone, and for the lanes the cone does not take the cap's Newton iteration and the
-// tangent ring. A lane with a non-finite trial is marked -1 and left unchanged.
-[[gnu::always_inline]] inline void ReturnLanes(const ConeConstants& c, ReturnGroup& g) {
+// SmoothCapReturn and PlasticUpdate's plastic-strain increments for four trial states in the
+// lanes, each operation as the scalar code orders it: the elastic test, the cone, and for the
+// lanes the cone does not take the cap's Newton iteration and the tangent ring. A lane with a non-finite trial is marked -1 and left unchanged.
+[[gnu::always_inline]] inline void ReturnLanes(const LaneConstants& c, ReturnGroup& g) {
   const Real4 a0 = Load4(g.tau[0]), a1 = Load4(g.tau[1]), a2 = Load4(g.tau[2]);
   const Real4 I1 = (a0 + a1) + a2, mean = I1 / 3.0;
   const Real4 s0 = a0 - mean, s1 = a1 - mean, s2 = a2 - mean;
@@ -232,10 +231,10 @@ using Mask4 = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
   Store4(g.region, elastic ? zero : (cone ? Splat4(1.0) : other));
 }
 
-void ReturnPortable(const ConeConstants& c, ReturnGroup& g) { ReturnLanes(c, g); }
+void ReturnPortable(const LaneConstants& c, ReturnGroup& g) { ReturnLanes(c, g); }
 
 #if SURGE_HAVE_WIDE_SIMD
-SURGE_TARGET_WIDE void ReturnWide(const ConeConstants& c, ReturnGroup& g) {
+SURGE_TARGET_WIDE void ReturnWide(const LaneConstants& c, ReturnGroup& g) {
   ReturnLanes(c, g);
 #if !defined(__clang__)
   _mm256_zeroupper();  // GCC 12 leaves the upper halves dirty (see SymmetricEigen4)
@@ -280,7 +279,7 @@ void PlasticUpdate4(const SmoothCapDruckerPragerParams& p, const HenckyTrial* t,
       g.tau[i][k] = t[k].tau(i);
       g.eps[i][k] = t[k].eps(i);
     }
-  const ConeConstants c = ConeConstantsOf(p);
+  const LaneConstants c = LaneConstantsOf(p);
 #if SURGE_HAVE_WIDE_SIMD
   WideSimd() ? ReturnWide(c, g) : ReturnPortable(c, g);
 #else

@@ -117,7 +117,7 @@ Real UpdateSpan(const Pm& params, Real dt, size_t k_begin, size_t k_end, const I
         h[i] = P.history.Get(p[i]);  // the run's slots, the rest zero
         J[i] = Det3(P.F[p[i]]);
       }
-      bool lanes = false;  // the return and finish four lanes wide, each lane bitwise the below
+      bool lanes = false;  // the return four lanes wide, each lane bitwise the loop below
       if constexpr (requires { PlasticUpdate4(params, t, J, b, h, stress); }) {
         lanes = n == 4;
         if (lanes) PlasticUpdate4(params, t, J, b, h, stress);
