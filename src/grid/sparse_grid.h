@@ -150,6 +150,8 @@ inline int64_t NodeFromOwner(const SparseGrid& grid, size_t owner, const Vec3i& 
 
 // Builds the topology for the given block requests (serial, deterministic: blocks are numbered
 // in tree order), the neighbour table and the colour lists, and sizes the node arrays (zeroed).
+// The tables depend on the set of blocks only: when it is that of the last call on this grid,
+// they are kept as they are.
 void BuildTopology(const std::vector<BlockRequest>& requests, SparseGrid& grid);
 
 // For each of n block coordinates, the block index (or -1 when the block is not active).

@@ -5,6 +5,7 @@
 // et al. 1996, IJSS 33:3277). Scatter as in particle_to_grid.cpp.
 #include "stabilize/antilocking.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -228,8 +229,15 @@ void Project(const StepContext& ctx, const Particles& P, const std::vector<Vec3>
              size_t begin, size_t end, const SparseGrid& grid, AntiLockingScratch& s,
              const Value& value, const Apply& apply) {
   using Pad = BlockPad<kDim, K>;
-  s.weight.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
-  s.weighted.assign(grid.block_count() * size_t(grid.block_nodes), 0.0);
+  // The sums start at zero, cleared block by block by the thread that owns the block (as the
+  // P2G sums in RebuildGrid): a serial clear was 0.5 % of a 1e4-particle water step.
+  const size_t per_block = size_t(grid.block_nodes);
+  s.weight.resize(grid.block_count() * per_block);
+  s.weighted.resize(grid.block_count() * per_block);
+  ForOwnedBlocks(grid, [&](size_t b) {
+    std::fill_n(s.weight.begin() + ptrdiff_t(b * per_block), per_block, 0.0);
+    std::fill_n(s.weighted.begin() + ptrdiff_t(b * per_block), per_block, 0.0);
+  });
   // Each block on the thread that owns its particles, every slot's sums in colour order.
   using Buffer = std::vector<Accum>;
   OrderedBlockScatter<Buffer>(
@@ -245,7 +253,6 @@ void Project(const StepContext& ctx, const Particles& P, const std::vector<Vec3>
   // then multiplies instead of dividing at every stencil node. An empty slot is never used with a
   // weight > 0: its node mean is 0, which the node gather multiplies by a zero weight; its cell
   // mean stays 0/0 = NaN (only a particle whose own q_p was not finite reads it, and skips it).
-  const size_t per_block = size_t(grid.block_nodes);
   ForOwnedBlocks(grid, [&](size_t b) {
     for (size_t g = b * per_block; g < (b + 1) * per_block; ++g)
       s.weighted[g] = kNode && s.weight[g] == 0 ? 0.0 : s.weighted[g] / s.weight[g];
