@@ -95,7 +95,8 @@ void ComputeRequests(const Particles& particles, Real inv_dx, const WallTouchMar
   [[maybe_unused]] const bool wide = WideSimd();
   ParallelChunks(n, [&](size_t chunk, size_t begin, size_t end) {
 #if SURGE_HAVE_WIDE_SIMD
-    if (wide) return RequestsOfChunkWide<kDim, K>(particles, inv_dx, walls, grid, chunk, begin, end);
+    if (wide)
+      return RequestsOfChunkWide<kDim, K>(particles, inv_dx, walls, grid, chunk, begin, end);
 #endif
     RequestsOfChunk<kDim, K>(particles, inv_dx, walls, grid, chunk, begin, end);
   });
