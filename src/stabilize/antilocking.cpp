@@ -532,23 +532,22 @@ struct MomentExponents {
   }
 };
 
-// Flushes a block's padded moment buffer into the grid slots (stride kMoments).
+// Adds the part of a block's padded moment buffer that lies in its upper neighbour o into the
+// grid slots (stride kMoments; OrderedBlockScatter's add).
 template <int kDim, class K, class F>
-void FlushMoments(const SparseGrid& grid, size_t blk, const std::vector<Real>& buf,
-                  AntiLockingScratch& s) {
+void AddMomentsIn(const SparseGrid& grid, size_t blk, const std::vector<Real>& buf, int o,
+                AntiLockingScratch& s) {
   using Pad = BlockPad<kDim, K>;
   constexpr int M = F::kMoments;
-  for (int a = 0; a < Pad::E; ++a)
-    for (int b = 0; b < Pad::E; ++b)
-      for (int c = 0; c < Pad::Ez; ++c) {
-        const Real* n = &buf[size_t(Pad::Index(a, b, c)) * M];
-        if (n[0] == 0) continue;
-        const long g = PaddedToGrid(grid, blk, a, b, c);
-        SURGE_ASSERT(g >= 0);
-        if (g < 0) continue;
-        Real* out = &s.moments[size_t(g) * M];
-        for (int j = 0; j < M; ++j) out[j] += n[j];
-      }
+  ForPaddedNodesIn<Pad>(o, [&](int a, int b, int c) {
+    const Real* n = &buf[size_t(Pad::Index(a, b, c)) * M];
+    if (n[0] == 0) return;
+    const long g = PaddedToGrid(grid, blk, a, b, c);
+    SURGE_ASSERT(g >= 0);
+    if (g < 0) return;
+    Real* out = &s.moments[size_t(g) * M];
+    for (int j = 0; j < M; ++j) out[j] += n[j];
+  });
 }
 
 // Moment sums of one block's particles of [begin, end), through the padded block buffer as in
@@ -558,18 +557,18 @@ void FlushMoments(const SparseGrid& grid, size_t blk, const std::vector<Real>& b
 // N_ip m_p at every node of the stencil, at xi = (x_p - x_i)/dx (node-centred, cell units).
 // The components: the filter of s.tensor[p], or with F::kTraceOnly the trace s.theta[p].
 template <int kDim, class K, bool kNode, class F>
-void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vector<Vec3>& x_n,
-                    size_t begin, size_t end, const SparseGrid& grid, size_t blk,
-                    std::vector<Real>& buf, AntiLockingScratch& s) {
+[[gnu::always_inline]] inline void ScatterMoments(const StepContext& ctx, const Particles& P,
+                                                  const std::vector<Vec3>& x_n, size_t begin,
+                                                  size_t end, const SparseGrid& grid, size_t blk,
+                                                  std::vector<Real>& buf,
+                                                  const AntiLockingScratch& s) {
   using Pad = BlockPad<kDim, K>;
   constexpr int M = F::kMoments;
   buf.assign(size_t(Pad::kSize) * M, 0.0);
   const Vec3i origin = grid.block_origin[blk];
-  bool any = false;
   for (uint32_t k = grid.block_begin[blk]; k < grid.block_begin[blk + 1]; ++k) {
     const uint32_t p = grid.sorted[k];
     if (p < begin || p >= end || !s.tensor_ok[p]) continue;
-    any = true;
     F f;
     if constexpr (F::kTraceOnly)
       f.q[0] = s.theta[p];
@@ -612,8 +611,92 @@ void ScatterMoments(const StepContext& ctx, const Particles& P, const std::vecto
       AddMoments<kDim, F>(&buf[size_t(Pad::Index(lc.x(), lc.y(), lc.z())) * M], P.mass[p], xi, f);
     }
   }
-  if (any) FlushMoments<kDim, K, F>(grid, blk, buf, s);
 }
+
+// ScatterMoments out of line, portable and AVX builds (as ScatterBlockWide: the same bits).
+template <int kDim, class K, bool kNode, class F>
+void ScatterMomentsPortable(const StepContext& ctx, const Particles& P,
+                            const std::vector<Vec3>& x_n, size_t begin, size_t end,
+                            const SparseGrid& grid, size_t blk, std::vector<Real>& buf,
+                            const AntiLockingScratch& s) {
+  ScatterMoments<kDim, K, kNode, F>(ctx, P, x_n, begin, end, grid, blk, buf, s);
+}
+#if SURGE_HAVE_WIDE_SIMD
+template <int kDim, class K, bool kNode, class F>
+SURGE_TARGET_WIDE void ScatterMomentsWide(const StepContext& ctx, const Particles& P,
+                                          const std::vector<Vec3>& x_n, size_t begin, size_t end,
+                                          const SparseGrid& grid, size_t blk,
+                                          std::vector<Real>& buf, const AntiLockingScratch& s) {
+  ScatterMoments<kDim, K, kNode, F>(ctx, P, x_n, begin, end, grid, blk, buf, s);
+}
+#endif
+
+// The node gather q^h_p = sum_i N_ip q-hat_i (4.32) of one particle run, from the node fits
+// s.node_fit (stride Q), each particle's sum handed to hand(p, sum).
+template <int kDim, class K, class F, class Hand>
+[[gnu::always_inline]] inline void GatherNodeFits(const StepContext& ctx, const Particles& P,
+                                                  const std::vector<Vec3>& x_n, size_t begin,
+                                                  size_t end, const SparseGrid& grid,
+                                                  const SparseGrid::ParticleRun& run,
+                                                  const AntiLockingScratch& s, const Hand& hand) {
+  using Pad = BlockPad<kDim, K>;
+  constexpr int Q = F::kLinear + F::kConst;
+  const size_t blk = run.block;
+  const Vec3i origin = grid.block_origin[blk];
+  // The block's padded node fits, copied once per run (as GatherBlock's halo: the same
+  // values, one neighbour lookup per node); 0 where no block is active (as an empty node:
+  // only zero weights meet them).
+  thread_local std::vector<Real> halo;
+  halo.resize(size_t(Pad::kSize) * Q);
+  for (int a = 0; a < Pad::E; ++a)
+    for (int b = 0; b < Pad::E; ++b)
+      for (int c = 0; c < Pad::Ez; ++c) {
+        const long g = PaddedToGrid(grid, blk, a, b, c);
+        Real* h = &halo[size_t(Pad::Index(a, b, c)) * Q];
+        for (int q = 0; q < Q; ++q)
+          h[q] = g < 0 ? 0.0 : s.node_fit[size_t(g) * Q + size_t(q)];
+      }
+  for (uint32_t k = run.begin; k < run.end; ++k) {
+    const uint32_t p = grid.sorted[k];
+    if (p < begin || p >= end || !s.tensor_ok[p]) continue;
+    Stencil<kDim, K> st;
+    st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
+    const Vec3i lb = st.base - origin;
+    // sum_i N_ip q-hat_i axis by axis, as GatherBlock (every node: empty ones hold 0).
+    F sum;
+    sum.q.fill(0);
+    for (int i = 0; i < st.W; ++i) {
+      std::array<Real, Q> sum_y{};
+      for (int j = 0; j < st.W; ++j) {
+        std::array<Real, Q> sum_z{};
+        const Real* row = &halo[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z())) * Q];
+        for (int c = 0; c < st.Wz; ++c)
+          for (int q = 0; q < Q; ++q) sum_z[size_t(q)] += st.w[2][c] * row[c * Q + q];
+        for (int q = 0; q < Q; ++q) sum_y[size_t(q)] += st.w[1][j] * sum_z[size_t(q)];
+      }
+      for (int q = 0; q < Q; ++q) sum.q[size_t(q)] += st.w[0][i] * sum_y[size_t(q)];
+    }
+    hand(p, sum);
+  }
+}
+
+template <int kDim, class K, class F, class Hand>
+void GatherNodeFitsPortable(const StepContext& ctx, const Particles& P,
+                            const std::vector<Vec3>& x_n, size_t begin, size_t end,
+                            const SparseGrid& grid, const SparseGrid::ParticleRun& run,
+                            const AntiLockingScratch& s, const Hand& hand) {
+  GatherNodeFits<kDim, K, F>(ctx, P, x_n, begin, end, grid, run, s, hand);
+}
+#if SURGE_HAVE_WIDE_SIMD
+template <int kDim, class K, class F, class Hand>
+SURGE_TARGET_WIDE void GatherNodeFitsWide(const StepContext& ctx, const Particles& P,
+                                          const std::vector<Vec3>& x_n, size_t begin, size_t end,
+                                          const SparseGrid& grid,
+                                          const SparseGrid::ParticleRun& run,
+                                          const AntiLockingScratch& s, const Hand& hand) {
+  GatherNodeFits<kDim, K, F>(ctx, P, x_n, begin, end, grid, run, s, hand);
+}
+#endif
 
 // The full-tensor approximation of one material group's per-particle tensor field s.tensor (the
 // particles with s.tensor_ok): AS2 / AS3CV on cell- or node-based control volumes, or the hybrid
@@ -658,29 +741,46 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
   // (fold_all): pressure RMS 0.0110 / 0.0117 / 0.0136 / 0.0136 at 1.5 / 2 / 3 / 4, unlimited
   // 0.0135, but then the full-tensor fit blows the barrier up (2026-12-07).
   constexpr Real kMaxNodeExtrapolation = 4;
-  s.moments.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(M), 0.0);
-  for (int colour = 0; colour < 8; ++colour) {
-    const auto& blocks = grid.colour[colour];
-    ParallelFor(blocks.size(), 1, [&](size_t i) {
-      thread_local std::vector<Real> buf;
-      if (node) {
-        ScatterMoments<kDim, K, true, F>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
-      } else {
-        ScatterMoments<kDim, K, false, F>(ctx, P, x_n, begin, end, grid, blocks[i], buf, s);
-      }
-    });
-  }
+  // The moment sums start at zero, cleared block by block by the thread that owns the block,
+  // then each block's sums on that thread, every slot's in colour order (OrderedBlockScatter:
+  // the sums of the colour-phased loop, bitwise, for any thread count).
+  const size_t per_block = size_t(grid.block_nodes) * size_t(M);
+  s.moments.resize(grid.block_count() * per_block);
+  ForOwnedBlocks(grid, [&](size_t b) {
+    std::fill_n(s.moments.begin() + ptrdiff_t(b * per_block), per_block, 0.0);
+  });
+  [[maybe_unused]] const bool wide = WideSimd();
+  using Buffer = std::vector<Real>;
+  OrderedBlockScatter<Buffer>(
+      grid, kDim,
+      [&](size_t b, Buffer& buf) {
+        const auto scatter = [&]<bool kNode>() {
+#if SURGE_HAVE_WIDE_SIMD
+          if (wide)
+            return ScatterMomentsWide<kDim, K, kNode, F>(ctx, P, x_n, begin, end, grid, b, buf, s);
+#endif
+          ScatterMomentsPortable<kDim, K, kNode, F>(ctx, P, x_n, begin, end, grid, b, buf, s);
+        };
+        if (node)
+          scatter.template operator()<true>();
+        else
+          scatter.template operator()<false>();
+      },
+      [&](size_t b, const Buffer& buf, int o) { AddMomentsIn<kDim, K, F>(grid, b, buf, o, s); });
   if (node) {
     // Node-based: the nodal values q-hat_i = S(xi_i) alpha_i (4.31), the support's fit at the
     // node itself (xi = 0 in node-centred coordinates); AS3CV takes the trace's weighted mean.
     // Then q^h_p = M* sum_i N_ip q-hat_i (4.32).
     constexpr int Q = F::kLinear + F::kConst;
-    s.node_fit.assign(grid.block_count() * size_t(grid.block_nodes) * size_t(Q), 0.0);
+    s.node_fit.resize(grid.block_count() * size_t(grid.block_nodes) * size_t(Q));
     ForOwnedBlocks(grid, [&](size_t blk) {
       for (int l = 0; l < grid.block_nodes; ++l) {
         const size_t g = blk * size_t(grid.block_nodes) + size_t(l);
         const Real* a = &s.moments[g * M];
-        if (a[0] == 0) continue;
+        if (a[0] == 0) {  // an empty node: 0 (only zero weights meet it)
+          std::fill_n(s.node_fit.begin() + ptrdiff_t(g * Q), Q, 0.0);
+          continue;
+        }
         // A node's fit is evaluated at the node, which can lie outside its particles (a free
         // surface, the outer nodes of a B-spline stencil): extrapolating a thin support's slopes
         // made the water tank blow up within 0.3 s with the cell criteria (1e-8, 1e-10). A node
@@ -698,46 +798,12 @@ void FitFullTensor(const StepContext& ctx, const Particles& P, const std::vector
         for (int q = 0; q < Q; ++q) s.node_fit[g * Q + size_t(q)] = fit.q[q];
       }
     });
-    using Pad = BlockPad<kDim, K>;
     ForOwnedRuns(grid, [&](size_t r) {
-      const SparseGrid::ParticleRun run = grid.runs[r];
-      const size_t blk = run.block;
-      const Vec3i origin = grid.block_origin[blk];
-      // The block's padded node fits, copied once per run (as GatherBlock's halo: the same
-      // values, one neighbour lookup per node); 0 where no block is active (as an empty node:
-      // only zero weights meet them).
-      thread_local std::vector<Real> halo;
-      halo.resize(size_t(Pad::kSize) * Q);
-      for (int a = 0; a < Pad::E; ++a)
-        for (int b = 0; b < Pad::E; ++b)
-          for (int c = 0; c < Pad::Ez; ++c) {
-            const long g = PaddedToGrid(grid, blk, a, b, c);
-            Real* h = &halo[size_t(Pad::Index(a, b, c)) * Q];
-            for (int q = 0; q < Q; ++q)
-              h[q] = g < 0 ? 0.0 : s.node_fit[size_t(g) * Q + size_t(q)];
-          }
-      for (uint32_t k = run.begin; k < run.end; ++k) {
-        const uint32_t p = grid.sorted[k];
-        if (p < begin || p >= end || !s.tensor_ok[p]) continue;
-        Stencil<kDim, K> st;
-        st.Compute(x_n[p], ctx.inv_dx, KernelHalfWidth<K>(kDim, P.volume0[p], ctx.inv_dx));
-        const Vec3i lb = st.base - origin;
-        // sum_i N_ip q-hat_i axis by axis, as GatherBlock (every node: empty ones hold 0).
-        F sum;
-        sum.q.fill(0);
-        for (int i = 0; i < st.W; ++i) {
-          std::array<Real, Q> sum_y{};
-          for (int j = 0; j < st.W; ++j) {
-            std::array<Real, Q> sum_z{};
-            const Real* row = &halo[size_t(Pad::Index(lb.x() + i, lb.y() + j, lb.z())) * Q];
-            for (int c = 0; c < st.Wz; ++c)
-              for (int q = 0; q < Q; ++q) sum_z[size_t(q)] += st.w[2][c] * row[c * Q + q];
-            for (int q = 0; q < Q; ++q) sum_y[size_t(q)] += st.w[1][j] * sum_z[size_t(q)];
-          }
-          for (int q = 0; q < Q; ++q) sum.q[size_t(q)] += st.w[0][i] * sum_y[size_t(q)];
-        }
-        hand(p, sum);
-      }
+#if SURGE_HAVE_WIDE_SIMD
+      if (wide)
+        return GatherNodeFitsWide<kDim, K, F>(ctx, P, x_n, begin, end, grid, grid.runs[r], s, hand);
+#endif
+      GatherNodeFitsPortable<kDim, K, F>(ctx, P, x_n, begin, end, grid, grid.runs[r], s, hand);
     });
     return;
   }

@@ -183,6 +183,11 @@ BENCHMARK_CAPTURE(BM_Step, quadratic_apic_mesh_obstacle, "quadratic_bspline", "a
 
 constexpr const char* kWater =
     "{model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e6, viscosity: 1.0e-3}";
+// The same water with the linear node fit of the trace (the settle recipe's anti-locking,
+// docs/antilocking.md "Linear node fit").
+constexpr const char* kWaterLinearFit =
+    "{model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e6, viscosity: 1.0e-3, "
+    "antilocking: {method: node, fit: linear}}";
 
 std::string ColumnScene(int dim, double particles, const char* material, bool geostatic) {
   const double dx = 0.02, ppc = dim == 3 ? 8 : 4;
@@ -278,6 +283,9 @@ BENCHMARK_CAPTURE(BM_Column, dp_3d_4M, 3, kSmoothCap)
 BENCHMARK_CAPTURE(BM_Column, dp_2d, 2, kSmoothCap)->Apply(ColumnArgs);
 BENCHMARK_CAPTURE(BM_Column, elastic_3d, 3, kRubber)->Apply(ColumnArgs);
 BENCHMARK_CAPTURE(BM_Column, water_3d, 3, kWater)->Apply(ColumnArgs);
+BENCHMARK_CAPTURE(BM_Column, water_linear_fit_3d, 3, kWaterLinearFit)
+    ->Args({10000, 1})->Args({10000, 2})->Args({100000, 1})->Args({100000, 2})
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 
 // The machine, not Surge: how long one cache line takes to go from one core to the other and
 // back (two threads hand a counter back and forth; counter: ns per round trip). On the 2-vCPU
