@@ -49,9 +49,11 @@ TEST(DeterminismTest, FlagshipSceneIsBitwiseIdenticalForOneAndTwoThreads) {
   EXPECT_EQ(h1, h2);
 }
 
-// The AVX builds of the kernels (core/simd.h: P2G, G2P, four spectral decompositions at a time)
-// against the portable ones, end to end: the flagship drop and the column impact's smooth-cap
-// sand with node anti-locking and a box obstacle (coarse, 0.2 s), each bitwise the same.
+// The AVX builds of the kernels (core/simd.h: P2G, G2P, four spectral decompositions at a time,
+// the grid rebuild's requests pass, the anti-locking's block scatters and gathers) against the
+// portable ones, end to end: the flagship drop and the column impact's smooth-cap sand with a
+// box obstacle (coarse, 0.2 s) under node AS1 (its default), the linear node fit and cell AS2,
+// and the 2-D tank drain (linear node fit, folded ghosts), each bitwise the same.
 TEST(DeterminismTest, WideKernelsGiveBitwiseThePortableResult) {
   const bool was = SetWideSimd(true);
   if (!WideSimd()) GTEST_SKIP() << "no AVX on this CPU";
@@ -60,15 +62,21 @@ TEST(DeterminismTest, WideKernelsGiveBitwiseThePortableResult) {
     std::vector<std::string> overrides;
     Real end;
   };
+  const std::string linear_fit = "materials.sand.antilocking={method: node, fit: linear}";
+  const std::string cell_as2 =
+      "materials.sand.antilocking={method: cell, approach: volumetric_deviatoric}";
   const Case cases[] = {{"elastic_drop_3d.yaml", {"grid.cell_size=0.08"}, 0.45},
-                        {"column_impact_3d.yaml", {"parameters.dx=1"}, 0.2}};
+                        {"column_impact_3d.yaml", {"parameters.dx=1"}, 0.2},
+                        {"column_impact_3d.yaml", {"parameters.dx=1", linear_fit}, 0.2},
+                        {"column_impact_3d.yaml", {"parameters.dx=1", cell_as2}, 0.2},
+                        {"tank_drain_2d.yaml", {}, 0.1}};
   for (const Case& c : cases) {
     uint64_t h[2];
     for (int wide = 0; wide < 2; ++wide) {
       SetWideSimd(wide == 1);
       h[wide] = RunWithThreads(c.file, c.overrides, c.end, 2);
     }
-    EXPECT_EQ(h[0], h[1]) << c.file;
+    EXPECT_EQ(h[0], h[1]) << c.file << (c.overrides.empty() ? "" : " " + c.overrides.back());
   }
   SetWideSimd(was);
 }
