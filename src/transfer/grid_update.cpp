@@ -55,47 +55,6 @@ WallTouchMarker::WallTouchMarker(const Model& model, Real dx, SparseGrid& grid)
   }
 }
 
-void WallTouchMarker::MarkTouched(const Vec3& x, Real volume0, Recent& recent) const {
-  for (int k = 0; k < count_; ++k) {
-    const WallPlane& w = walls_[k];
-    const Real d = w.sign * (x[w.axis] - w.level);
-    if (d <= 0 || (dim_ == 3 ? d * d * d : d * d) <= near_.c_touch * volume0)
-      MarkColumns(x, volume0, k, recent.range[k]);
-  }
-}
-
-void WallTouchMarker::MarkColumns(const Vec3& x, Real volume0, int k, int* recent) const {
-  SparseGrid::WallTouch& t = grid_->wall_touch[k];
-  // GIMP: the particle's half width adds to the reach (only there: the root is not free).
-  const Real r = !gimp_ ? reach_
-                        : reach_ + 0.5 * (dim_ == 3 ? std::cbrt(volume0) : std::sqrt(volume0));
-  int range[2][2];  // node index range along the two tangential axes
-  for (int j = 1; j <= 2; ++j) {
-    const int a = (t.axis + j) % 3;
-    if (a >= dim_) {
-      range[j - 1][0] = range[j - 1][1] = 0;
-      continue;
-    }
-    // nodes with |x_i - x_p| < r (a weight exactly at the edge of the support is zero)
-    range[j - 1][0] = int(std::floor((x[a] - r) * inv_dx_)) + 1;
-    range[j - 1][1] = int(std::ceil((x[a] + r) * inv_dx_)) - 1;
-  }
-  if (range[0][0] == recent[0] && range[0][1] == recent[1] && range[1][0] == recent[2] &&
-      range[1][1] == recent[3])
-    return;  // marked just before
-  recent[0] = range[0][0];
-  recent[1] = range[0][1];
-  recent[2] = range[1][0];
-  recent[3] = range[1][1];
-  const int a1 = (t.axis + 1) % 3, a2 = (t.axis + 2) % 3;
-  const int i1_end = std::min(range[0][1] - t.lo[a1], t.n1 - 1);
-  const int i2_end = std::min(range[1][1] - t.lo[a2], t.n2 - 1);
-  for (int i1 = std::max(range[0][0] - t.lo[a1], 0); i1 <= i1_end; ++i1)
-    for (int i2 = std::max(range[1][0] - t.lo[a2], 0); i2 <= i2_end; ++i2)
-      if (std::atomic_ref<uint8_t> mark(t.touched[size_t(i1) * t.n2 + i2]);
-          mark.load(std::memory_order_relaxed) == 0)  // a line both threads mark stays shared
-        mark.store(1, std::memory_order_relaxed);
-}
 
 void UpdateGridVelocity(const Model& model, const StepContext& ctx, SparseGrid& grid,
                         WallReport& report) {

@@ -105,13 +105,9 @@ void ComputeRequests(const Particles& particles, Real inv_dx, const WallTouchMar
 }
 
 // Pass 2, after the topology is built: the index of every particle's owner block, through its
-// request (every requested block exists), so that no particle's block is computed twice.
+// request (every requested block exists; BuildTopology gives their indices), so that no
+// particle's block is computed twice.
 void FindOwnerBlocks(SparseGrid& grid) {
-  std::vector<Vec3i>& blocks = grid.request_blocks;
-  blocks.resize(grid.requests.size());
-  for (size_t r = 0; r < blocks.size(); ++r) blocks[r] = grid.requests[r].block;
-  grid.request_block.resize(blocks.size());
-  LookupBlocks(grid, blocks.data(), blocks.size(), grid.request_block.data());
   std::array<size_t, kReductionChunks + 1> offset{};
   for (size_t c = 0; c < kReductionChunks; ++c)
     offset[c + 1] = offset[c] + grid.chunk_requests[c].size();
