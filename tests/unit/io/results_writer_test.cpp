@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <tbb/global_control.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -314,6 +315,72 @@ TEST_F(ResultsWriterTest, EmptySnapshotAndLargeCompressedSnapshot) {
   EXPECT_EQ(Read<int64_t>(f, "/snapshots/000001/id", H5T_NATIVE_INT64).back(),
             int64_t(100 + n - 1));
   H5Fclose(f);
+}
+
+// A snapshot of several chunks and an edge chunk (40 000 particles: 16 384 rows a chunk), whose
+// chunks the writer shuffles and deflates itself on the worker threads (H5Dwrite_chunk): HDF5
+// reads every array back through its own shuffle and deflate filters bit for bit, on 1 and 2
+// threads, and the arrays are stored compressed.
+TEST_F(ResultsWriterTest, SelfDeflatedChunksReadBackThroughTheFilters) {
+  const size_t n = 40000;
+  State s = TinyState(n);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (size_t p = 0; p < n; ++p) {
+    s.particles.x[p] = Vec3(noise(rng), 0.01 * double(p), 3.0 + noise(rng));
+    s.particles.v[p] = Vec3(noise(rng), -noise(rng), 1e-3 * noise(rng));
+    Mat3 t;
+    t << noise(rng), noise(rng), noise(rng), 0, noise(rng), noise(rng), 0, 0, noise(rng);
+    s.particles.stress[p] = Mat3(1e4 * (t + t.transpose()));
+    s.particles.material[p] = int32_t(p % 3);
+  }
+  for (const int threads : {1, 2}) {
+    const std::string name = "chunks" + std::to_string(threads);
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      ResultsWriter w(dir_.string(), name, RunMetadata{}, TinyModel());
+      w.WriteSnapshot(s);
+      w.Close(StageSeconds{}, 0, 0, "completed");
+    }
+    hid_t f = H5Fopen((dir_ / (name + ".h5")).c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    const auto pos = ReadDoubles(f, "/snapshots/000000/position");
+    const auto vel = ReadDoubles(f, "/snapshots/000000/velocity");
+    const auto stress = ReadDoubles(f, "/snapshots/000000/stress");
+    const auto ids = Read<int64_t>(f, "/snapshots/000000/id", H5T_NATIVE_INT64);
+    const auto materials = Read<int32_t>(f, "/snapshots/000000/material", H5T_NATIVE_INT32);
+    ASSERT_EQ(pos.size(), 3 * n);
+    ASSERT_EQ(stress.size(), 6 * n);
+    ASSERT_EQ(ids.size(), n);
+    for (size_t p = 0; p < n; ++p) {
+      for (int d = 0; d < 3; ++d) {
+        ASSERT_EQ(pos[3 * p + size_t(d)], s.particles.x[p][d]) << p;
+        ASSERT_EQ(vel[3 * p + size_t(d)], s.particles.v[p][d]) << p;
+      }
+      for (int k = 0; k < 6; ++k)
+        ASSERT_EQ(stress[6 * p + size_t(k)], s.particles.stress[p].v[k]) << p;
+      ASSERT_EQ(ids[p], s.particles.id[p]) << p;
+      ASSERT_EQ(materials[p], s.particles.material[p]) << p;
+    }
+    // The pipeline a reader sees: shuffle, then deflate; 16 384-row chunks; stored compressed.
+    hid_t ds = H5Dopen2(f, "/snapshots/000000/stress", H5P_DEFAULT);
+    hid_t plist = H5Dget_create_plist(ds);
+    ASSERT_EQ(H5Pget_nfilters(plist), 2);
+    unsigned flags = 0, values[4];
+    size_t nvalues = 4;
+    EXPECT_EQ(H5Pget_filter2(plist, 0, &flags, &nvalues, values, 0, nullptr, nullptr),
+              H5Z_FILTER_SHUFFLE);
+    nvalues = 4;
+    EXPECT_EQ(H5Pget_filter2(plist, 1, &flags, &nvalues, values, 0, nullptr, nullptr),
+              H5Z_FILTER_DEFLATE);
+    hsize_t chunk[2] = {0, 0};
+    EXPECT_EQ(H5Pget_chunk(plist, 2, chunk), 2);
+    EXPECT_EQ(chunk[0], 16384u);
+    EXPECT_LT(H5Dget_storage_size(ds), 6 * n * sizeof(double));
+    H5Pclose(plist);
+    H5Dclose(ds);
+    H5Fclose(f);
+  }
 }
 
 TEST_F(ResultsWriterTest, DestructorWithoutCloseKeepsSnapshotsAndEnergy) {
