@@ -150,30 +150,37 @@ void WriteArray(hid_t loc, const char* name, hid_t mem_type, hid_t file_type, co
   const size_t row_bytes = value_bytes * std::max<size_t>(cols, 1);
   const size_t chunk_bytes = size_t(chunk_rows) * row_bytes, total = n * row_bytes;
   const size_t chunks = (n + size_t(chunk_rows) - 1) / size_t(chunk_rows);
-  std::vector<std::vector<Bytef>> packed(chunks);
-  std::atomic<bool> failed{false};
-  ParallelFor(chunks, 1, [&](size_t c) {
-    const size_t begin = c * chunk_bytes, bytes = std::min(chunk_bytes, total - begin);
-    const Bytef* src = static_cast<const Bytef*>(data) + begin;
-    // Shuffle: byte b of value i goes to b * count + i; the edge chunk's values past n are the
-    // fill value 0.
-    const size_t count = chunk_bytes / value_bytes, present = bytes / value_bytes;
-    std::vector<Bytef> shuffled(chunk_bytes, 0);
-    for (size_t i = 0; i < present; ++i)
-      for (size_t b = 0; b < value_bytes; ++b) shuffled[b * count + i] = src[i * value_bytes + b];
-    uLongf size = compressBound(uLong(chunk_bytes));
-    packed[c].resize(size);
-    if (compress2(packed[c].data(), &size, shuffled.data(), uLong(chunk_bytes), kDeflateLevel) !=
-        Z_OK)
-      failed = true;
-    packed[c].resize(size);
-  });
-  Require(!failed, std::string("deflate dataset ") + name, path);
-  for (size_t c = 0; c < chunks; ++c) {
-    const hsize_t offset[2] = {hsize_t(c) * chunk_rows, 0};
-    Require(H5Dwrite_chunk(ds.get(), H5P_DEFAULT, 0, offset, packed[c].size(),
-                           packed[c].data()) >= 0,
-            std::string("write dataset ") + name, path);
+  // In batches of a few chunks per thread, so that the compressed copies held at once stay a
+  // few MB however large the array (a 4e6-particle stress array is 192 MB).
+  const size_t batch = 4 * std::max<size_t>(WorkerThreads(), 1);
+  std::vector<std::vector<Bytef>> packed(std::min(batch, chunks));
+  for (size_t first = 0; first < chunks; first += batch) {
+    const size_t count_here = std::min(batch, chunks - first);
+    std::atomic<bool> failed{false};
+    ParallelFor(count_here, 1, [&](size_t k) {
+      const size_t c = first + k;
+      const size_t begin = c * chunk_bytes, bytes = std::min(chunk_bytes, total - begin);
+      const Bytef* src = static_cast<const Bytef*>(data) + begin;
+      // Shuffle: byte b of value i goes to b * count + i; the edge chunk's values past n are
+      // the fill value 0.
+      const size_t count = chunk_bytes / value_bytes, present = bytes / value_bytes;
+      std::vector<Bytef> shuffled(chunk_bytes, 0);
+      for (size_t i = 0; i < present; ++i)
+        for (size_t b = 0; b < value_bytes; ++b) shuffled[b * count + i] = src[i * value_bytes + b];
+      uLongf size = compressBound(uLong(chunk_bytes));
+      packed[k].resize(size);
+      if (compress2(packed[k].data(), &size, shuffled.data(), uLong(chunk_bytes),
+                    kDeflateLevel) != Z_OK)
+        failed = true;
+      packed[k].resize(size);
+    });
+    Require(!failed, std::string("deflate dataset ") + name, path);
+    for (size_t k = 0; k < count_here; ++k) {  // in chunk order
+      const hsize_t offset[2] = {hsize_t(first + k) * chunk_rows, 0};
+      Require(H5Dwrite_chunk(ds.get(), H5P_DEFAULT, 0, offset, packed[k].size(),
+                             packed[k].data()) >= 0,
+              std::string("write dataset ") + name, path);
+    }
   }
 }
 

@@ -317,12 +317,13 @@ TEST_F(ResultsWriterTest, EmptySnapshotAndLargeCompressedSnapshot) {
   H5Fclose(f);
 }
 
-// A snapshot of several chunks and an edge chunk (40 000 particles: 16 384 rows a chunk), whose
-// chunks the writer shuffles and deflates itself on the worker threads (H5Dwrite_chunk): HDF5
-// reads every array back through its own shuffle and deflate filters bit for bit, on 1 and 2
-// threads, and the arrays are stored compressed.
+// A snapshot of ten chunks, the last an edge chunk (150 000 particles: 16 384 rows a chunk),
+// whose chunks the writer shuffles and deflates itself on the worker threads (H5Dwrite_chunk),
+// in batches of 4 chunks per thread (three batches on 1 thread, two on 2): HDF5 reads every
+// array back through its own shuffle and deflate filters bit for bit, and the arrays are stored
+// compressed.
 TEST_F(ResultsWriterTest, SelfDeflatedChunksReadBackThroughTheFilters) {
-  const size_t n = 40000;
+  const size_t n = 150000;
   State s = TinyState(n);
   std::mt19937_64 rng(7);
   std::normal_distribution<double> noise(0.0, 1.0);
