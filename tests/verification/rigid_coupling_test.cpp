@@ -35,6 +35,7 @@ struct Tank {
   std::string antilocking = "none";
   int slab_cells = 2;                   // slab thickness along z [cells]
   std::string ghosts = "mirror";        // domain.ghost_nodes
+  std::string faces = "interpolated";   // the box's contact.faces
 };
 
 std::string FloatScene(const Tank& t, Real box_density) {
@@ -66,6 +67,7 @@ obstacles:
     shape: {box: {min: [)" + s(x0) + ", " + s(t.water) + R"(, 0], max: [)" + s(x0 + t.width) +
          ", " + s(t.water + t.height) + ", " + slab + R"(]}}
     motion: {dynamic: {density: )" + s(box_density) + R"(}}
+    contact: {faces: )" + t.faces + R"(}
 )";
 }
 
@@ -227,14 +229,15 @@ TEST(RigidCouplingTest, FoldedGhostNodesFloatTheBoxWithinThreePercentAtThisResol
 // The draft error against resolution in the coarse tank (about 4 min single-threaded; run by
 // hand with --gtest_also_run_disabled_tests --gtest_filter=*Resolution*). Measured 2026-11-23
 // (draft below the open water, compressible Archimedes): see docs/validation.md.
-// SURGE_FLOAT_RUNS="ghosts slab dx[,dx...]" (e.g. "fold_all 3 0.02,0.0125") runs those cells
-// instead, with the default antilocking (none).
+// SURGE_FLOAT_RUNS="ghosts slab dx[,dx...] [faces]" (e.g. "fold_all 3 0.02,0.0125 nodes") runs
+// those cells instead, with the default antilocking (none) and contact.faces (interpolated).
 TEST(RigidCouplingTest, DISABLED_FloatingBoxResolution) {
   if (const char* runs = std::getenv("SURGE_FLOAT_RUNS")) {
     std::istringstream in(runs);
     Tank t;
     std::string sizes;
     in >> t.ghosts >> t.slab_cells >> sizes;
+    if (std::string faces; in >> faces) t.faces = faces;
     std::istringstream list(sizes);
     for (std::string dx; std::getline(list, dx, ',');) {
       t.dx = std::stod(dx);
