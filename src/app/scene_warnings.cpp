@@ -87,6 +87,12 @@ void ObstacleWarnings(const Model& m, std::vector<std::string>& out) {
   }
 }
 
+// The anti-locking settings of a body, or null without any.
+const AntiLocking* AntiLockingOf(const Model& m, const BodyInfo& body) {
+  if (body.antilocking < 0 || size_t(body.antilocking) >= m.antilocking.size()) return nullptr;
+  return &m.antilocking[size_t(body.antilocking)];
+}
+
 }  // namespace
 
 std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
@@ -164,15 +170,15 @@ std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
     const Material& mat = m.materials[size_t(body.material)];
     const bool fluid = std::visit(
         [](const auto& p) { return kIsFluid<std::decay_t<decltype(p)>>; }, mat.params);
-    if (fluid || body.antilocking < 0 || size_t(body.antilocking) >= m.antilocking.size()) continue;
-    const AntiLocking& al = m.antilocking[size_t(body.antilocking)];
-    if (al.stress && (al.method == AntiLockingMethod::kNode || al.method == AntiLockingMethod::kHybrid))
+    const AntiLocking* al = AntiLockingOf(m, body);
+    if (fluid || !al) continue;
+    if (al->stress && (al->method == AntiLockingMethod::kNode || al->method == AntiLockingMethod::kHybrid))
       out.push_back(fmt::format(
           "body '{}' (material '{}'): stress averaging on node supports (antilocking method {}, "
           "stress: true) smooths the total mean stress of a solid and damps its bending (an "
           "incompressible cantilever stops oscillating, docs/antilocking.md); use method: cell "
           "or stress: false",
-          body.name, mat.name, al.method == AntiLockingMethod::kNode ? "node" : "hybrid"));
+          body.name, mat.name, al->method == AntiLockingMethod::kNode ? "node" : "hybrid"));
   }
   // Water brought to rest by local damping under node-based AS1 (the Newtonian fluid's default):
   // the node average is the support's centroid value, half a cell inside a wall or the surface,
@@ -183,12 +189,10 @@ std::vector<std::string> SceneWarnings(const LoadedScene& scene) {
   if (m.damping.alpha > 0 && std::min(m.damping.until, m.time.end) >= 1.0) {
     for (const BodyInfo& body : m.bodies) {
       const Material& mat = m.materials[size_t(body.material)];
-      if (!std::holds_alternative<NewtonianFluidParams>(mat.params) || body.antilocking < 0 ||
-          size_t(body.antilocking) >= m.antilocking.size())
-        continue;
-      const AntiLocking& al = m.antilocking[size_t(body.antilocking)];
-      if (al.method != AntiLockingMethod::kNode || al.linear_trace ||
-          al.approach != AntiLockingApproach::kVolumetric)
+      const AntiLocking* al = AntiLockingOf(m, body);
+      if (!std::holds_alternative<NewtonianFluidParams>(mat.params) || !al ||
+          al->method != AntiLockingMethod::kNode || al->linear_trace ||
+          al->approach != AntiLockingApproach::kVolumetric)
         continue;
       out.push_back(fmt::format(
           "body '{}' (material '{}'): water settled by damping under node-based anti-locking "
