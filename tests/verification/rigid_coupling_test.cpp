@@ -36,6 +36,10 @@ struct Tank {
   int slab_cells = 2;                   // slab thickness along z [cells]
   std::string ghosts = "mirror";        // domain.ghost_nodes
   std::string faces = "interpolated";   // the box's contact.faces
+  bool shifting = false;                // the water's particle_shifting
+  Real creep_from = -1;                 // if >= 0: also the mean bottom over [creep_from, +0.5 s]
+  Real max_tilt = 1e-3;                 // [rad]: a stable section (width / height 2) stays upright
+  Real max_inside = 1e-4;               // deepest particle inside the box at the end [h]
 };
 
 std::string FloatScene(const Tank& t, Real box_density) {
@@ -56,7 +60,8 @@ domain:
 materials:
   water: {model: newtonian_fluid, density: 1000, bulk_modulus: )" + s(t.bulk) +
          ", viscosity: " + s(t.viscosity) + R"(,
-          antilocking: {method: )" + t.antilocking + R"(}}
+          antilocking: {method: )" + t.antilocking + R"(}, particle_shifting: )" +
+         (t.shifting ? "true" : "false") + R"(}
 bodies:
   - name: water
     material: water
@@ -82,8 +87,10 @@ std::string FloatScene(Real box_density) {
 struct Floating {
   Real draft;       // box bottom below the open water's surface [m]
   Real draft_tank;  // below the surface that the whole tank's water mass gives [m]
+  Real draft_visible;  // below the visible surface (top particles of the open columns + h / 4) [m]
   Real expected;    // Archimedes [m]
   Real force, weight;  // mean water force on the box and its weight [N]
+  Real creep;       // mean bottom over the averaging window minus over Tank::creep_from's [m]
 };
 
 // Drops a box of half the water's density into the tank and measures its draft against
@@ -107,14 +114,18 @@ Floating FloatingBox(const Tank& t) {
   const Real slab = t.slab_cells * t.dx, open = t.tank - t.width, c = kRhoW * kG / t.bulk;
   LoadedScene scene = LoadSceneFromString(FloatScene(t, kRhoB), "floating_box.yaml");
   const Real water_mass = testing::TotalMass(scene.state.particles);
-  Real bottom = 0, force_y = 0, open_mass = 0, visible = 0, tilt = 0;
-  int n = 0;
+  Real bottom = 0, force_y = 0, open_mass = 0, visible = 0, tilt = 0, early = 0;
+  int n = 0, n_early = 0;
   const int bins = int(std::lround(t.tank / (0.5 * t.dx)));  // columns h / 2 wide
   std::vector<Real> top(static_cast<size_t>(bins));
   const auto started = std::chrono::steady_clock::now();
   testing::RunUntil(scene, t.end, [&](const State& s, const StepReport& r) {
     const RigidBodyState& b = s.rigid.at(0);
     tilt = std::max(tilt, std::acos(std::min(Real(1), b.rotation(1, 1))));
+    if (t.creep_from >= 0 && s.time >= t.creep_from && s.time < t.creep_from + 0.5) {
+      early += b.position.y() - 0.5 * t.height;
+      ++n_early;
+    }
     if (s.time < t.average_from) return;
     bottom += b.position.y() - 0.5 * t.height;  // reference point = box centre
     force_y += r.obstacles.at(0).force.y();     // the water's push on the box, upward
@@ -150,8 +161,8 @@ Floating FloatingBox(const Tank& t) {
               -deepest, tilt);
   // Explicit coupling: the contact saw the body at t_n, so particles may lie v dt inside its
   // pose at t_{n+1}; the next step's contact and projection take them out.
-  EXPECT_LT(-deepest, 1e-4 * t.dx);
-  EXPECT_LT(tilt, 1e-3);  // a stable section (width / height 2) stays upright
+  EXPECT_LT(-deepest, t.max_inside * t.dx);
+  EXPECT_LT(tilt, t.max_tilt);
   // Open water: m = rho0 (s + c s^2 / 2), fixed point (c s / 2 < 1 %).
   const Real per_area = open_mass / (kRhoW * slab * open);
   Real surface = per_area;
@@ -169,15 +180,19 @@ Floating FloatingBox(const Tank& t) {
   const Real draft = surface - bottom, draft_tank = tank_surface - bottom;
   auto err = [&](Real d) { return 100 * (d / expected - 1); };
   std::printf("floating box (h = %g m, %.2f cells per draft, anti-locking %s, mu %g Pa s, slab %d "
-              "cells, ghost nodes %s): draft "
+              "cells, ghost nodes %s%s): draft "
               "%.5f m below the open water (error %+.2f %%; visible surface %+.2f %%; whole "
               "tank's mass %+.2f %%), Archimedes %.5f m; mean water force %.4f N, weight %.4f N "
               "(%+.2f %%); box bottom %.4f m; %.1f s\n",
               t.dx, expected / t.dx, t.antilocking.c_str(), t.viscosity, t.slab_cells,
-              t.ghosts.c_str(), draft, err(draft),
+              t.ghosts.c_str(), t.shifting ? ", particle shifting" : "", draft, err(draft),
               err(visible - bottom), err(draft_tank), expected, force_y, weight,
               100 * (force_y / weight - 1), bottom, seconds);
-  return {draft, draft_tank, expected, force_y, weight};
+  const Real creep = n_early > 0 ? bottom - early / n_early : 0;
+  if (n_early > 0)
+    std::printf("  bottom moved %+.2f mm from the window at %.1f s to the last one\n", 1e3 * creep,
+                t.creep_from);
+  return {draft, draft_tank, visible - bottom, expected, force_y, weight, creep};
 }
 
 // KNOWN GAP (issue #5 asks for the draft within 3 %): at h = 0.02 m (2.5 cells of draft) the
@@ -226,11 +241,50 @@ TEST(RigidCouplingTest, FoldedGhostNodesFloatTheBoxWithinThreePercentAtThisResol
   EXPECT_LT(std::abs(f.draft - f.expected), 0.6 * std::abs(m.draft - m.expected));
 }
 
+// Node-based anti-locking (AS1, the Newtonian fluid's default) lets the water's particles crowd
+// at the floor: each particle's J is replaced by its supports' mean, so a particle pressed closer
+// to its neighbours than its J says meets no pressure. In this tank (slab three cells thick,
+// mirrored ghosts) the particle volume J V0 in the bottom 0.04 m band reaches 1.4x its space by
+// 2 s and 1.7x by 5 s, with or without the box, in 2-D and in a slab eight cells thick
+// (by hand, 2026-12-08; docs/antilocking.md, "Crowding"); the floating box rides the crowding
+// water down: its bottom sank 0.1198 -> 0.1151 -> 0.1092 -> 0.1066 m at 1 / 2 / 4 / 5 s (without
+// anti-locking 0.1245 / 0.1230 / 0.1226 / 0.1222). Particle shifting (particle_shifting: true)
+// moves crowded particles apart: the box then stops within 0.5 mm after 2 s and floats at its
+// Archimedes draft below the visible surface. Below the open water's mass-based surface it reads
+// deeper (+15 %): the shifted open water still holds about 4 % more particle volume than its
+// space, most of it in the top band, so its mass stands for a surface higher than the one seen.
+// KNOWN GAP: with shifting the symmetric box does not stay upright. It tilts by 0.023 rad within
+// 0.25 s of the drop, 0.082 rad at 0.5 s, and then rocks by about +-0.03 rad to 5 s (without
+// shifting it stays at 0 to all digits), and a particle ends up to 2e-4 h inside it; the
+// shifting's share in that is not found yet (docs/antilocking.md, "Crowding").
+TEST(RigidCouplingTest, NodeAntiLockingLetsTheFloatingBoxSinkUnlessTheParticlesShift) {
+  Tank plain;
+  plain.slab_cells = 3;
+  plain.antilocking = "node";
+  plain.end = 4.0;
+  plain.average_from = 3.5;
+  plain.creep_from = 2.0;
+  Tank shifted = plain;
+  shifted.shifting = true;
+  shifted.max_tilt = 0.12;     // measured 0.082 rad (the known gap above)
+  shifted.max_inside = 1e-3;   // measured 2.0e-4 h
+  const Floating p = FloatingBox(plain);
+  const Floating s = FloatingBox(shifted);
+  EXPECT_LT(p.creep, -0.003);  // measured -4.5 mm from 2.0-2.5 s to 3.5-4 s; shifted -0.12 mm
+  EXPECT_GT(p.draft_visible, 1.1 * p.expected);
+  EXPECT_LT(std::abs(s.creep), 0.001);
+  EXPECT_NEAR(s.draft_visible, s.expected, 0.03 * s.expected);
+  EXPECT_NEAR(s.force, s.weight, 0.03 * s.weight);
+}
+
 // The draft error against resolution in the coarse tank (about 4 min single-threaded; run by
 // hand with --gtest_also_run_disabled_tests --gtest_filter=*Resolution*). Measured 2026-11-23
 // (draft below the open water, compressible Archimedes): see docs/validation.md.
 // SURGE_FLOAT_RUNS="ghosts slab dx[,dx...] [faces]" (e.g. "fold_all 3 0.02,0.0125 nodes") runs
-// those cells instead, with the default antilocking (none) and contact.faces (interpolated).
+// those cells instead, with the default antilocking (none) and contact.faces (interpolated);
+// SURGE_FLOAT_AL (the antilocking map's inside, e.g. "node, fit: linear"), SURGE_FLOAT_SHIFT
+// (set: particle_shifting) and SURGE_FLOAT_END (run end; the average is over its last 0.5 s)
+// change those runs.
 TEST(RigidCouplingTest, DISABLED_FloatingBoxResolution) {
   if (const char* runs = std::getenv("SURGE_FLOAT_RUNS")) {
     std::istringstream in(runs);
@@ -238,6 +292,12 @@ TEST(RigidCouplingTest, DISABLED_FloatingBoxResolution) {
     std::string sizes;
     in >> t.ghosts >> t.slab_cells >> sizes;
     if (std::string faces; in >> faces) t.faces = faces;
+    if (const char* al = std::getenv("SURGE_FLOAT_AL")) t.antilocking = al;
+    if (std::getenv("SURGE_FLOAT_SHIFT")) t.shifting = true;
+    if (const char* e = std::getenv("SURGE_FLOAT_END")) {
+      t.end = std::stod(e);
+      t.average_from = t.end - 0.5;
+    }
     std::istringstream list(sizes);
     for (std::string dx; std::getline(list, dx, ',');) {
       t.dx = std::stod(dx);

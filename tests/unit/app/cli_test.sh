@@ -47,6 +47,27 @@ expect check_fold_all_thin_slab_warn 0 'warning +domain\.ghost_nodes: fold_all w
 if "$surge" check "$src/scenes/tank_drain_2d.yaml" 2>&1 | grep -q "fold_all with the walls"; then echo "FAIL check_fold_all_quiet: warned on the shipped tank drain"; fail=$((fail + 1)); else echo "ok   check_fold_all_quiet"; pass=$((pass + 1)); fi
 expect check_settle_node_warn 0 "warning +body 'column' \\(material 'water'\\): water settled by damping under node-based anti-locking" -- "$surge" check "$src/scenes/dam_break_barrier_2d.yaml" --set 'damping={local: 0.7, until: 4}'
 if "$surge" check "$src/scenes/dam_break_barrier_2d.yaml" --set 'damping={local: 0.7, until: 4}' --set 'materials.water.antilocking={method: node, fit: linear}' 2>&1 | grep -q "water settled by damping"; then echo "FAIL check_settle_recipe_quiet: warned on the settle recipe"; fail=$((fail + 1)); else echo "ok   check_settle_recipe_quiet"; pass=$((pass + 1)); fi
+cat > "$work/floating.yaml" <<'YAML'
+name: floating
+dimension: 3
+time: {end: 1}
+gravity: [0, -9.81, 0]
+grid: {cell_size: 0.02}
+domain:
+  min: [0, 0, 0]
+  max: [0.6, 0.4, 0.06]
+  walls: {x-: slip, x+: slip, y-: slip, z-: slip, z+: slip}
+materials:
+  water: {model: newtonian_fluid, density: 1000, bulk_modulus: 2.0e5, viscosity: 5}
+bodies:
+  - {name: tank, material: water, region: {box: {min: [0, 0, 0], max: [0.6, 0.16, 0.06]}}}
+obstacles:
+  - name: box
+    shape: {box: {min: [0.2, 0.16, 0], max: [0.4, 0.26, 0.06]}}
+    motion: {dynamic: {density: 500}}
+YAML
+expect check_floating_node_warn 0 "warning +body 'tank' \\(material 'water'\\): under node-based anti-locking the water's particles crowd" -- "$surge" check "$work/floating.yaml"
+if "$surge" check "$work/floating.yaml" --set materials.water.particle_shifting=true 2>&1 | grep -q "particles crowd"; then echo "FAIL check_floating_shift_quiet: warned with particle shifting"; fail=$((fail + 1)); else echo "ok   check_floating_shift_quiet"; pass=$((pass + 1)); fi
 expect check_cutoff_above_apex_warn 0 'warning +materials\.sand: tension_cutoff 1000 Pa is at or above the apex' -- "$surge" check "$src/scenes/geostatic_column_2d.yaml" --set materials.sand.tension_cutoff=1000
 expect check_mach_warn_bingham 0 'warning +materials\.mud: .*Mach' -- "$surge" check "$src/scenes/mudflow_2d.yaml" --set materials.mud.bulk_modulus=1.0e3
 expect info_lists_models 0 'materials: .*j2.*newtonian_fluid' -- "$surge" info
